@@ -1,0 +1,373 @@
+"""Configuration: YAML in, one validated frozen dataclass tree out.
+
+``yaml.safe_load`` → per-key checks → normalised values → cross-field checks.
+Every problem is gathered and raised together in a single :class:`ConfigError`
+that names the file and the key, so a user fixes a file in one pass.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Any, Callable, Dict, Mapping, Optional, Tuple, Union
+
+import yaml
+
+from ._compat import frozen
+from .core.types import CameraIntrinsics, LandmarkGeometry
+from .errors import ConfigError
+
+DEFAULT_PORT = 47800
+METHODS = ("fast", "paper")
+MODELS = ("pinhole", "paper")
+SOURCES = ("recorded", "opencv", "picamera2", "synthetic")
+WHITE_BALANCE = ("grey_world", "none")
+
+
+@frozen
+class DetectionConfig:
+    """How bands are found. ``method: paper`` is the paper's pipeline as published."""
+
+    method: str = "fast"
+    median_ksize: int = 15
+    downscale: int = 2
+    white_balance: str = "grey_world"
+    red_hue: Tuple[Tuple[int, int], ...] = ((0, 10), (165, 179))
+    blue_hue: Tuple[Tuple[int, int], ...] = ((98, 132),)
+    s_min: int = 90
+    v_min: int = 25
+    min_band_px: float = 3.0
+    max_landmarks: int = 16
+    tracking: bool = True
+    full_scan_every: int = 8
+
+
+@frozen
+class ModelConfig:
+    """Range and bearing from band centroids.
+
+    ``pinhole``: d_v = k/L + c, bearing = atan(px/f) after undistortion.
+    ``paper``: d_v = k/L, d_h = kh·px, θ = atan(d_h/d_v), d = d_v/cos θ.
+    """
+
+    kind: str = "pinhole"
+    k_px_m: float = 34.87
+    c_m: float = 0.0137
+    kh_m_per_px: float = 0.00079
+    cylinder_correction: bool = True
+    envelope_range_m: Tuple[float, float] = (0.15, 2.0)
+    envelope_bearing_rad: Tuple[float, float] = (-0.45, 0.45)
+
+
+@frozen
+class SourceConfig:
+    """Where frames come from (the daemon and ``record``)."""
+
+    kind: str = "picamera2"
+    path: str = ""
+    fps: float = 30.0
+    loop: bool = False
+    device: str = "0"
+    camera_num: int = 0
+    width_px: int = 640
+    height_px: int = 480
+    hflip: bool = False
+    vflip: bool = False
+    buffer_count: int = 4
+    timeout_s: float = 2.0
+    retries: int = 5
+    controls: Tuple[Tuple[str, Any], ...] = ()
+
+
+@frozen
+class PublishConfig:
+    """Where readings go: unicast destinations and an opt-in multicast group."""
+
+    robot_id: str = "zumo"
+    unicast: Tuple[Tuple[str, int], ...] = (("127.0.0.1", DEFAULT_PORT),)
+    multicast_group: str = ""
+    multicast_port: int = DEFAULT_PORT
+    multicast_ttl: int = 1
+    multicast_interface: str = "127.0.0.1"
+
+
+@frozen
+class DaemonConfig:
+    """The capture loop's housekeeping."""
+
+    status_interval_s: float = 5.0
+    echo: bool = False
+
+
+@frozen
+class Config:
+    """The whole validated configuration."""
+
+    camera: CameraIntrinsics = CameraIntrinsics()
+    landmark: LandmarkGeometry = LandmarkGeometry()
+    detection: DetectionConfig = DetectionConfig()
+    model: ModelConfig = ModelConfig()
+    source: SourceConfig = SourceConfig()
+    publish: PublishConfig = PublishConfig()
+    daemon: DaemonConfig = DaemonConfig()
+    source_file: str = "<defaults>"
+
+
+# --- per-key checks ---------------------------------------------------------
+# A check takes the raw YAML value and returns the normalised value or raises
+# ValueError with a short reason.
+
+Check = Callable[[Any], Any]
+
+
+def _number(lo: float = -math.inf, hi: float = math.inf, integer: bool = False) -> Check:
+    def check(v: Any) -> Any:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise ValueError(f"expected a number, got {v!r}")
+        if integer and not float(v).is_integer():
+            raise ValueError(f"expected an integer, got {v!r}")
+        if not math.isfinite(v) or not lo <= v <= hi:
+            raise ValueError(f"{v!r} is outside [{lo}, {hi}]")
+        return int(v) if integer else float(v)
+
+    return check
+
+
+def _positive(integer: bool = False) -> Check:
+    inner = _number(0, math.inf, integer)
+
+    def check(v: Any) -> Any:
+        out = inner(v)
+        if out <= 0:
+            raise ValueError(f"must be > 0, got {v!r}")
+        return out
+
+    return check
+
+
+def _bool(v: Any) -> bool:
+    if not isinstance(v, bool):
+        raise ValueError(f"expected true or false, got {v!r}")
+    return v
+
+
+def _choice(*choices: str) -> Check:
+    def check(v: Any) -> str:
+        if v not in choices:
+            raise ValueError(f"{v!r} is not one of {', '.join(choices)}")
+        return str(v)
+
+    return check
+
+
+def _string(v: Any) -> str:
+    if isinstance(v, bool) or not isinstance(v, (str, int)):
+        raise ValueError(f"expected a string, got {v!r}")
+    return str(v)
+
+
+def _odd_ksize(v: Any) -> int:
+    n = _number(1, 99, integer=True)(v)
+    if n % 2 == 0:
+        raise ValueError(f"must be odd, got {n}")
+    return int(n)
+
+
+def _pair(lo: float, hi: float, integer: bool = False, ordered: bool = True) -> Check:
+    num = _number(lo, hi, integer)
+
+    def check(v: Any) -> Tuple[Any, Any]:
+        if not isinstance(v, (list, tuple)) or len(v) != 2:
+            raise ValueError(f"expected a pair [low, high], got {v!r}")
+        a, b = num(v[0]), num(v[1])
+        if ordered and a > b:
+            raise ValueError(f"low {a} is above high {b}")
+        return (a, b)
+
+    return check
+
+
+def _hue_ranges(v: Any) -> Tuple[Tuple[int, int], ...]:
+    if isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, int) for x in v):
+        v = [v]
+    if not isinstance(v, (list, tuple)) or not v:
+        raise ValueError(f"expected a list of [low, high] hue ranges (0-179), got {v!r}")
+    return tuple(_pair(0, 179, integer=True)(r) for r in v)
+
+
+def _distortion(v: Any) -> Tuple[float, ...]:
+    if not isinstance(v, (list, tuple)) or len(v) not in (4, 5, 8):
+        raise ValueError(f"expected 4, 5 or 8 OpenCV coefficients, got {v!r}")
+    return tuple(_number()(c) for c in v)
+
+
+def _host_port(v: Any) -> Tuple[str, int]:
+    if isinstance(v, str) and v.rpartition(":")[0]:
+        host, _, port = v.rpartition(":")
+        return (host.strip("[]"), _number(1, 65535, integer=True)(int(port) if port.isdigit() else port))
+    raise ValueError(f"expected 'host:port', got {v!r}")
+
+
+def _destinations(v: Any) -> Tuple[Tuple[str, int], ...]:
+    if not isinstance(v, (list, tuple)):
+        raise ValueError(f"expected a list of 'host:port', got {v!r}")
+    return tuple(_host_port(d) for d in v)
+
+
+def _controls(v: Any) -> Tuple[Tuple[str, Any], ...]:
+    if v is None:
+        return ()
+    if not isinstance(v, Mapping):
+        raise ValueError(f"expected a mapping of Picamera2 control names to values, got {v!r}")
+    out = []
+    for key, val in v.items():
+        if not isinstance(key, str) or not key[:1].isupper():
+            raise ValueError(f"control name {key!r} should be a libcamera control such as AeEnable")
+        if isinstance(val, list):
+            val = tuple(val)
+        out.append((key, val))
+    return tuple(out)
+
+
+SCHEMA: Dict[str, Tuple[type, Dict[str, Check]]] = {
+    "camera": (CameraIntrinsics, {
+        "width_px": _positive(True), "height_px": _positive(True),
+        "fx_px": _positive(), "fy_px": _positive(),
+        "cx_px": _number(0, 10000), "cy_px": _number(0, 10000),
+        "distortion": _distortion,
+    }),
+    "landmark": (LandmarkGeometry, {
+        "height_m": _positive(), "diameter_m": _positive(), "band_height_m": _positive(),
+    }),
+    "detection": (DetectionConfig, {
+        "method": _choice(*METHODS), "median_ksize": _odd_ksize,
+        "downscale": _number(1, 4, integer=True), "white_balance": _choice(*WHITE_BALANCE),
+        "red_hue": _hue_ranges, "blue_hue": _hue_ranges,
+        "s_min": _number(0, 255, integer=True), "v_min": _number(0, 255, integer=True),
+        "min_band_px": _number(1, 100), "max_landmarks": _positive(True),
+        "tracking": _bool, "full_scan_every": _positive(True),
+    }),
+    "model": (ModelConfig, {
+        "kind": _choice(*MODELS), "k_px_m": _positive(), "c_m": _number(-0.5, 0.5),
+        "kh_m_per_px": _positive(), "cylinder_correction": _bool,
+        "envelope_range_m": _pair(0, 100), "envelope_bearing_rad": _pair(-math.pi, math.pi),
+    }),
+    "source": (SourceConfig, {
+        "kind": _choice(*SOURCES), "path": _string, "fps": _positive(), "loop": _bool,
+        "device": _string, "camera_num": _number(0, 16, integer=True),
+        "width_px": _positive(True), "height_px": _positive(True),
+        "hflip": _bool, "vflip": _bool, "buffer_count": _number(1, 16, integer=True),
+        "timeout_s": _positive(), "retries": _number(0, 1000, integer=True), "controls": _controls,
+    }),
+    "publish": (PublishConfig, {
+        "robot_id": _string, "unicast": _destinations, "multicast_group": _string,
+        "multicast_port": _number(1, 65535, integer=True),
+        "multicast_ttl": _number(0, 255, integer=True), "multicast_interface": _string,
+    }),
+    "daemon": (DaemonConfig, {"status_interval_s": _positive(), "echo": _bool}),
+}
+
+
+def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Config] = None) -> Config:
+    """Validate a parsed YAML mapping into a :class:`Config`, starting from ``base``."""
+    base = base or Config()
+    problems: list[str] = []
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        raise ConfigError([f"top level must be a mapping of sections, got {type(data).__name__}"], source)
+    sections: Dict[str, Any] = {}
+    for name in data:
+        if name not in SCHEMA:
+            problems.append(f"unknown section {name!r} (known: {', '.join(SCHEMA)})")
+    for name, (_cls, checks) in SCHEMA.items():
+        current = getattr(base, name)
+        raw = data.get(name)
+        if raw is None:
+            sections[name] = current
+            continue
+        if not isinstance(raw, Mapping):
+            problems.append(f"{name}: must be a mapping, got {raw!r}")
+            sections[name] = current
+            continue
+        values: Dict[str, Any] = {}
+        for key, val in raw.items():
+            if key not in checks:
+                problems.append(f"{name}.{key}: unknown key (known: {', '.join(checks)})")
+                continue
+            try:
+                values[key] = checks[key](val)
+            except (ValueError, TypeError) as exc:
+                problems.append(f"{name}.{key}: {exc}")
+        sections[name] = dataclasses.replace(current, **values)
+    cfg = Config(**sections, source_file=source)
+    problems.extend(_cross_checks(cfg))
+    if problems:
+        raise ConfigError(problems, source)
+    return cfg
+
+
+def _cross_checks(cfg: Config) -> list[str]:
+    p = []
+    cam, lm = cfg.camera, cfg.landmark
+    if not 0 <= cam.cx_px < cam.width_px:
+        p.append(f"camera.cx_px: {cam.cx_px} is outside the image width {cam.width_px}")
+    if not 0 <= cam.cy_px < cam.height_px:
+        p.append(f"camera.cy_px: {cam.cy_px} is outside the image height {cam.height_px}")
+    if 2 * lm.band_height_m >= lm.height_m:
+        p.append("landmark.band_height_m: two bands do not fit in landmark.height_m")
+    if cfg.source.kind in ("recorded",) and not cfg.source.path:
+        p.append("source.path: required when source.kind is 'recorded'")
+    if cfg.publish.multicast_group:
+        parts = cfg.publish.multicast_group.split(".")
+        if len(parts) != 4 or not all(x.isdigit() for x in parts) or not 224 <= int(parts[0]) <= 239:
+            p.append(f"publish.multicast_group: {cfg.publish.multicast_group!r} is not an IPv4 multicast address")
+    return p
+
+
+def load_config(path: Union[str, Path, None] = None) -> Config:
+    """Load and validate a YAML config; ``None`` gives the built-in defaults.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing, unreadable, not YAML, or has invalid keys; the
+        message lists every problem found.
+    """
+    if path is None:
+        return Config()
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError([f"cannot read file: {exc.strerror or exc}"], source) from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError([f"not valid YAML: {exc}".replace("\n", " ")], source) from None
+    return config_from_mapping(data, source)
+
+
+def config_to_mapping(cfg: Config) -> Dict[str, Any]:
+    """The YAML-ready mapping of a config (what ``calibrate`` writes)."""
+
+    def plain(v: Any) -> Any:
+        return [plain(x) for x in v] if isinstance(v, tuple) else v
+
+    special: Dict[Tuple[str, str], Callable[[Any], Any]] = {
+        ("source", "controls"): lambda v: {k: plain(x) for k, x in v},
+        ("publish", "unicast"): lambda v: [f"{h}:{p}" for h, p in v],
+    }
+    out: Dict[str, Any] = {}
+    for name in SCHEMA:
+        section = getattr(cfg, name)
+        out[name] = {}
+        for key in SCHEMA[name][1]:
+            out[name][key] = special.get((name, key), plain)(getattr(section, key))
+    return out
+
+
+def dump_config(cfg: Config) -> str:
+    """The config as YAML text that :func:`load_config` accepts unchanged."""
+    return yaml.safe_dump(config_to_mapping(cfg), sort_keys=False, default_flow_style=None)

@@ -1,0 +1,142 @@
+"""Frozen value types shared by the pipeline stages, the model and the renderer.
+
+Units are in the names: ``_m`` metres, ``_rad`` radians, ``_px`` pixels.
+Image coordinates have x to the right and y down, origin at the top-left pixel
+centre. Bearings are positive to the *left* of the optical axis (REP 103).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Tuple
+
+from .._compat import frozen
+
+XY = Tuple[float, float]
+BBox = Tuple[int, int, int, int]  # x, y, width, height in pixels
+
+
+@frozen
+class CameraIntrinsics:
+    """Pinhole intrinsics of the camera that took the frames.
+
+    ``distortion`` holds OpenCV coefficients ``(k1, k2, p1, p2, k3)``; all zero
+    means an ideal pinhole.
+    """
+
+    width_px: int = 640
+    height_px: int = 480
+    fx_px: float = 634.0
+    fy_px: float = 634.0
+    cx_px: float = 319.5
+    cy_px: float = 239.5
+    distortion: Tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0)
+
+    @property
+    def has_distortion(self) -> bool:
+        return any(c != 0.0 for c in self.distortion)
+
+    @property
+    def hfov_rad(self) -> float:
+        return 2.0 * math.atan(self.width_px / (2.0 * self.fx_px))
+
+    def scaled(self, width_px: int, height_px: int) -> CameraIntrinsics:
+        """The same camera at another resolution (same field of view)."""
+        sx = width_px / self.width_px
+        sy = height_px / self.height_px
+        return CameraIntrinsics(
+            width_px=width_px,
+            height_px=height_px,
+            fx_px=self.fx_px * sx,
+            fy_px=self.fy_px * sy,
+            cx_px=(self.cx_px + 0.5) * sx - 0.5,
+            cy_px=(self.cy_px + 0.5) * sy - 0.5,
+            distortion=self.distortion,
+        )
+
+
+@frozen
+class LandmarkGeometry:
+    """The passive landmark: a cylinder with a red band on top and a blue one below."""
+
+    height_m: float = 0.070
+    diameter_m: float = 0.035
+    band_height_m: float = 0.015
+
+    @property
+    def radius_m(self) -> float:
+        return self.diameter_m / 2.0
+
+    @property
+    def band_spacing_m(self) -> float:
+        """Vertical distance between the red and blue band centres (55 mm by default)."""
+        return self.height_m - self.band_height_m
+
+
+@frozen
+class Blob:
+    """One connected region of a colour class, in full-resolution pixels."""
+
+    cx_px: float
+    cy_px: float
+    area_px: float
+    bbox_px: BBox
+
+    @property
+    def width_px(self) -> int:
+        return self.bbox_px[2]
+
+    @property
+    def height_px(self) -> int:
+        return self.bbox_px[3]
+
+
+@frozen
+class BandPair:
+    """A red blob paired with the blue blob below it: one landmark candidate."""
+
+    red: Blob
+    blue: Blob
+
+    @property
+    def bbox_px(self) -> BBox:
+        x0 = min(self.red.bbox_px[0], self.blue.bbox_px[0])
+        y0 = min(self.red.bbox_px[1], self.blue.bbox_px[1])
+        x1 = max(self.red.bbox_px[0] + self.red.bbox_px[2], self.blue.bbox_px[0] + self.blue.bbox_px[2])
+        y1 = max(self.red.bbox_px[1] + self.red.bbox_px[3], self.blue.bbox_px[1] + self.blue.bbox_px[3])
+        return (x0, y0, x1 - x0, y1 - y0)
+
+    @property
+    def l_px(self) -> float:
+        """Pixel distance between the band centroids (the paper's L)."""
+        return math.hypot(self.blue.cx_px - self.red.cx_px, self.blue.cy_px - self.red.cy_px)
+
+
+@frozen
+class Landmark:
+    """One landmark seen in one frame: range, bearing and what they came from.
+
+    ``d_v_m`` is the depth along the optical axis and ``d_h_m`` the lateral
+    offset (positive left), as in the paper's figure 3; ``range_m`` is measured
+    in the horizontal plane from the camera centre to the landmark's axis.
+    """
+
+    range_m: float
+    bearing_rad: float
+    d_v_m: float
+    d_h_m: float
+    l_px: float
+    red_xy_px: XY
+    blue_xy_px: XY
+    width_px: float
+    bbox_px: BBox
+    in_envelope: bool
+
+
+@frozen
+class FrameResult:
+    """Everything the pipeline found in one frame. Nothing seen is an empty tuple."""
+
+    landmarks: Tuple[Landmark, ...]
+    stage_s: Tuple[Tuple[str, float], ...] = ()
+    tracked: bool = False

@@ -1,0 +1,46 @@
+"""The one exception tree of rangebearing.
+
+Every error the package raises on purpose derives from :class:`RangeBearingError`
+and also from the matching builtin, so callers may catch either.
+"""
+
+from __future__ import annotations
+
+
+class RangeBearingError(Exception):
+    """Root of every error rangebearing raises on purpose."""
+
+
+class ConfigError(RangeBearingError, ValueError):
+    """A configuration file or value is invalid; the message names every problem."""
+
+    def __init__(self, problems: list[str] | str, source: str = "<config>") -> None:
+        self.problems = [problems] if isinstance(problems, str) else list(problems)
+        self.source = source
+        lines = "\n".join(f"  - {p}" for p in self.problems)
+        n = len(self.problems)
+        super().__init__(f"{source}: {n} problem{'s' if n != 1 else ''}:\n{lines}")
+
+
+class FrameError(RangeBearingError, ValueError):
+    """A frame is unusable (wrong shape, wrong dtype, empty, corrupt)."""
+
+
+class SourceError(RangeBearingError, OSError):
+    """A frame source cannot be opened or read."""
+
+
+class CameraError(SourceError):
+    """The camera is missing, busy, or stopped delivering frames."""
+
+
+class CalibrationError(RangeBearingError, ValueError):
+    """The calibration data cannot support a fit."""
+
+
+class ProtocolError(RangeBearingError, ValueError):
+    """A datagram is not a valid rangebearing reading."""
+
+
+class TruthError(RangeBearingError, ValueError):
+    """A ground-truth file is malformed."""
