@@ -1,0 +1,1 @@
+"""The ``rangebearing`` command line: thin handlers over the library."""

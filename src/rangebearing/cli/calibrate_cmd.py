@@ -1,0 +1,116 @@
+"""``rangebearing calibrate``: fit the range model to frames with known range and bearing."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import sys
+from pathlib import Path
+from typing import Any, List
+
+from ..config import dump_config
+from ..core.calibrate import Fit, Sample, fit_model
+from ..core.pipeline import Pipeline
+from ..errors import CalibrationError, RangeBearingError
+from ..evaluate import match_frame
+from ..sources.recorded import count_recorded, iter_recorded
+from ..truth import read_truth
+from .common import add_config_arg, config_from_args, progress
+
+# Before calibration the model may be far off; match detections to truth loosely.
+CALIBRATION_GAP_RAD = math.radians(10.0)
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "calibrate",
+        help="fit the range model to frames with known range and bearing",
+        description="Detect landmarks in frames whose true range and bearing are known, fit the "
+        "model (config model.kind: pinhole or paper) and write a complete config that --config accepts.",
+    )
+    p.add_argument("path", help="directory of images or a video file")
+    p.add_argument("--truth", required=True, metavar="FILE", help="CSV frame,range_m,bearing_rad")
+    p.add_argument("--out", required=True, metavar="FILE", help="where to write the calibrated config (YAML)")
+    add_config_arg(p)
+    p.add_argument("--plot", metavar="FILE.png", help="plot measured against true range and the residuals")
+    p.set_defaults(func=run)
+
+
+def collect_samples(path: Path, truth: dict, pipe: Pipeline) -> List[Sample]:
+    """Detect landmarks in every frame and pair them with their truth."""
+    cam = pipe.cfg.camera
+    samples = []
+    for name, image in progress(iter_recorded(path), count_recorded(path), "calibrate"):
+        rows = truth.get(name, [])
+        if image is None or not rows:
+            continue
+        found = pipe.process(image).landmarks
+        matches, _ = match_frame(name, found, rows, CALIBRATION_GAP_RAD)
+        for m in matches:
+            if m.found is None:
+                continue
+            lm = m.found
+            px_left = cam.cx_px - 0.5 * (lm.red_xy_px[0] + lm.blue_xy_px[0])
+            samples.append(Sample(name, lm.l_px, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad))
+    return samples
+
+
+def print_fit(fit: Fit) -> None:
+    m = fit.model
+    if m.kind == "paper":
+        print(f"model paper: d_v = {m.k_px_m * 100:.1f} px·cm / L,  d_h = {m.kh_m_per_px * 100:.5f} cm/px · px")
+    else:
+        print(f"model pinhole: range = {m.k_px_m:.4f} px·m / (L·cos θ) + {m.c_m * 1000:.2f} mm")
+    print(f"{'frame':>16} {'true m':>8} {'fit m':>8} {'err %':>7} {'true °':>8} {'err °':>7}")
+    for r in fit.residuals:
+        print(
+            f"{r.frame:>16} {r.range_m:8.4f} {r.fitted_range_m:8.4f} {r.range_err_pct:+7.2f} "
+            f"{math.degrees(r.bearing_rad):+8.2f} {r.bearing_err_deg:+7.3f}"
+        )
+    print(
+        f"fit over {len(fit.residuals)} landmarks: range error mean {fit.range_err_pct_mean:.2f} % "
+        f"(max {fit.range_err_pct_max:.2f} %), bearing error mean {fit.bearing_err_deg_mean:.3f}°"
+    )
+    (r0, r1), (b0, b1) = m.envelope_range_m, m.envelope_bearing_rad
+    print(f"envelope: range {r0:.3f}–{r1:.3f} m, bearing {math.degrees(b0):+.1f}° to {math.degrees(b1):+.1f}°")
+
+
+def plot_fit(fit: Fit, path: str) -> None:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise RangeBearingError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
+    true = [r.range_m for r in fit.residuals]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
+    a.plot(true, [r.fitted_range_m for r in fit.residuals], "o", ms=3)
+    a.plot([min(true), max(true)], [min(true), max(true)], "k--", lw=1)
+    a.set(xlabel="true range (m)", ylabel="measured range (m)", title=f"{fit.model.kind} model")
+    b.plot(true, [r.range_err_pct for r in fit.residuals], "o", ms=3)
+    b.axhline(0, color="k", lw=1)
+    b.set(xlabel="true range (m)", ylabel="range residual (%)", title="residuals")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def run(args: argparse.Namespace) -> int:
+    cfg = config_from_args(args)
+    truth = read_truth(args.truth)
+    samples = collect_samples(Path(args.path), truth, Pipeline(cfg, track=False))
+    fit = fit_model(samples, cfg.model)
+    print_fit(fit)
+    out = Path(args.out)
+    header = f"# rangebearing config written by 'rangebearing calibrate' from {args.path}\n"
+    try:
+        out.write_text(header + dump_config(dataclasses.replace(cfg, model=fit.model)), encoding="utf-8")
+    except OSError as exc:
+        raise CalibrationError(f"cannot write {out}: {exc.strerror or exc}") from None
+    print(f"wrote {out}", file=sys.stderr)
+    if args.plot:
+        plot_fit(fit, args.plot)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return 0

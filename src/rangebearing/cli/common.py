@@ -1,0 +1,44 @@
+"""Pieces shared by the command handlers: config loading, progress, reading lines."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Iterable, Iterator, Optional, TypeVar
+
+from ..config import Config, load_config
+from ..core.types import Landmark
+
+T = TypeVar("T")
+
+
+def add_config_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--config", metavar="FILE", help="YAML config (default: built-in defaults)")
+
+
+def config_from_args(args: argparse.Namespace) -> Config:
+    return load_config(getattr(args, "config", None))
+
+
+def progress(items: Iterable[T], total: Optional[int], label: str, enabled: Optional[bool] = None) -> Iterator[T]:
+    """Yield ``items`` while drawing a progress bar on stderr when it is a terminal."""
+    show = sys.stderr.isatty() if enabled is None else enabled
+    n = 0
+    for n, item in enumerate(items, 1):
+        if show and (n % 5 == 0 or n == total):
+            if total:
+                done = int(30 * n / total)
+                sys.stderr.write(f"\r{label} [{'#' * done}{'.' * (30 - done)}] {n}/{total}")
+            else:
+                sys.stderr.write(f"\r{label} {n}")
+            sys.stderr.flush()
+        yield item
+    if show and n:
+        sys.stderr.write("\n")
+
+
+def describe(lm: Landmark) -> str:
+    """One landmark as ``0.412 m  +12.3°`` (with a note when outside the envelope)."""
+    note = "" if lm.in_envelope else " (out of envelope)"
+    return f"{lm.range_m:.3f} m {math.degrees(lm.bearing_rad):+6.2f}°{note}"

@@ -1,0 +1,128 @@
+"""Band detection in a frame or a window of it: the fast path and the paper's path.
+
+Fast path (default), per region of the frame::
+
+    downscale (area) → grey-world balance → HSV → red/blue hue thresholds
+    → median (majority) filter of the masks, sized to keep the farthest band
+    → connected regions → pairing → sub-pixel moments on the *unfiltered*
+      full-resolution pixels inside each paired band
+
+The filter decides *where* the bands are; the moments of the original pixels
+decide *exactly where*: a median over the colour image rounds the band corners
+and moves the centroids, which costs range accuracy.
+
+Paper path: median filter over the whole colour frame, HSV, thresholds, and
+the moments of the whole red and blue masks — one landmark at most.
+"""
+
+from __future__ import annotations
+
+from typing import List, Optional, Tuple
+
+import cv2
+import numpy as np
+
+from .._compat import frozen
+from ..config import DetectionConfig
+from .blobs import find_blobs, mask_centroid, weighted_centroid
+from .color import Gains, apply_gains, hue_mask, soft_weights, to_hsv
+from .denoise import majority_filter, median_filter
+from .pairing import PairingLimits, pair_bands
+from .types import XY, BandPair, BBox
+
+Region = Tuple[int, int, int, int]  # x0, y0, x1, y1 (exclusive), full-resolution pixels
+
+
+@frozen
+class BandCentroids:
+    """Sub-pixel centroids of one landmark's bands and the region they came from."""
+
+    red_xy_px: XY
+    blue_xy_px: XY
+    width_px: float
+    bbox_px: BBox
+
+
+def region_masks(
+    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Filtered red and blue masks of one region at ``1/cfg.downscale`` resolution."""
+    x0, y0, x1, y1 = region
+    s = cfg.downscale
+    roi = bgr[y0:y1, x0:x1]
+    small = roi if s == 1 else cv2.resize(roi, ((x1 - x0) // s, (y1 - y0) // s), interpolation=cv2.INTER_AREA)
+    hsv = to_hsv(apply_gains(small, gains))
+    red = majority_filter(hue_mask(hsv, cfg.red_hue, cfg.s_min, cfg.v_min), ksize)
+    blue = majority_filter(hue_mask(hsv, cfg.blue_hue, cfg.s_min, cfg.v_min), ksize)
+    return red, blue
+
+
+def find_pairs(
+    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
+) -> List[BandPair]:
+    """Candidate landmarks (paired band blobs) inside one region of the frame."""
+    red, blue = region_masks(bgr, region, cfg, gains, ksize)
+    s = cfg.downscale
+    min_area = cfg.min_band_px * cfg.min_band_px
+    off = (region[0], region[1])
+    reds = find_blobs(red, s, off, min_area)
+    blues = find_blobs(blue, s, off, min_area)
+    if not reds or not blues:
+        return []
+    return pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
+
+
+def refine_pair(bgr: np.ndarray, pair: BandPair, cfg: DetectionConfig, gains: Gains) -> Optional[BandCentroids]:
+    """Sub-pixel band centroids from the unfiltered full-resolution pixels of one pair.
+
+    Each band's weights come from :func:`soft_weights` inside its blob's
+    bounding box grown by a margin that covers the downscaling and the
+    filter's erosion of the edges.
+    """
+    h, w = bgr.shape[:2]
+    margin = cfg.downscale + 1
+    x0, y0, bw, bh = pair.bbox_px
+    rx0, ry0 = max(0, x0 - margin), max(0, y0 - margin)
+    rx1, ry1 = min(w, x0 + bw + margin), min(h, y0 + bh + margin)
+    hsv = to_hsv(apply_gains(bgr[ry0:ry1, rx0:rx1], gains))
+    out = []
+    for blob, hues in ((pair.red, cfg.red_hue), (pair.blue, cfg.blue_hue)):
+        bx, by, bw_, bh_ = blob.bbox_px
+        ax0, ay0 = max(bx - margin, rx0) - rx0, max(by - margin, ry0) - ry0
+        ax1, ay1 = min(bx + bw_ + margin, rx1) - rx0, min(by + bh_ + margin, ry1) - ry0
+        c = weighted_centroid(soft_weights(hsv[ay0:ay1, ax0:ax1], hues, cfg.s_min, cfg.v_min))
+        if c is None:
+            return None
+        out.append((rx0 + ax0 + c[0], ry0 + ay0 + c[1]))
+    width = 0.5 * (pair.red.width_px + pair.blue.width_px)
+    return BandCentroids(red_xy_px=out[0], blue_xy_px=out[1], width_px=width, bbox_px=pair.bbox_px)
+
+
+def detect_region(
+    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
+) -> List[BandCentroids]:
+    """Every landmark's band centroids inside one region (fast path)."""
+    found = []
+    for pair in find_pairs(bgr, region, cfg, gains, ksize, limits, geometry):
+        c = refine_pair(bgr, pair, cfg, gains)
+        if c is not None:
+            found.append(c)
+    return found
+
+
+def detect_paper(bgr: np.ndarray, cfg: DetectionConfig) -> List[BandCentroids]:
+    """The paper's pipeline as published: median over the colour frame, HSV, whole-mask moments.
+
+    Finds at most one landmark: the centroid of *all* red pixels and of *all*
+    blue pixels, so a second landmark or any red/blue object corrupts it.
+    """
+    hsv = to_hsv(median_filter(bgr, cfg.median_ksize))
+    red = mask_centroid(hue_mask(hsv, cfg.red_hue, cfg.s_min, cfg.v_min))
+    blue = mask_centroid(hue_mask(hsv, cfg.blue_hue, cfg.s_min, cfg.v_min))
+    if red is None or blue is None or blue[1] <= red[1]:
+        return []
+    bw = float(np.sqrt(red[2]))
+    x0 = int(min(red[0], blue[0]) - bw)
+    y0 = int(red[1] - bw)
+    bbox = (x0, y0, int(2 * bw), int(blue[1] - red[1] + 2 * bw))
+    return [BandCentroids(red_xy_px=(red[0], red[1]), blue_xy_px=(blue[0], blue[1]), width_px=bw, bbox_px=bbox)]

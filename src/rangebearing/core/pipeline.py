@@ -1,0 +1,147 @@
+"""The pipeline: one BGR frame in, every landmark's range and bearing out.
+
+:class:`Pipeline` is pure apart from its own state: it keeps the previous
+frame's landmarks when tracking, so that the next frame is searched only in
+windows around them, with a full-frame search every ``full_scan_every``
+frames (and whenever nothing is tracked) so that a newcomer is found within
+that many frames.
+"""
+
+from __future__ import annotations
+
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+
+from ..config import Config
+from ..errors import FrameError
+from .color import UNIT_GAINS, Gains, grey_world_gains
+from .denoise import band_preserving_ksize
+from .detect import BandCentroids, Region, detect_paper, detect_region
+from .model import in_envelope, reading
+from .pairing import PairingLimits
+from .types import BBox, CameraIntrinsics, FrameResult, Landmark
+
+
+def check_frame(frame: object) -> np.ndarray:
+    """Return ``frame`` if it is a non-empty H×W×3 uint8 array, else raise :class:`FrameError`."""
+    if not isinstance(frame, np.ndarray):
+        raise FrameError(f"frame is {type(frame).__name__}, not a numpy array")
+    if frame.ndim != 3 or frame.shape[2] != 3:
+        raise FrameError(f"frame has shape {frame.shape}, expected (height, width, 3) BGR")
+    if frame.dtype != np.uint8:
+        raise FrameError(f"frame has dtype {frame.dtype}, expected uint8")
+    if frame.shape[0] < 8 or frame.shape[1] < 8:
+        raise FrameError(f"frame of {frame.shape[1]}×{frame.shape[0]} pixels is too small")
+    return frame
+
+
+def grow(bbox: BBox, frame_w: int, frame_h: int, step: int) -> Region:
+    """A search window around a landmark's box: grown by half its size plus 8 px, clipped,
+    with width and height multiples of ``step`` (the downscale factor)."""
+    x, y, w, h = bbox
+    mx, my = w // 2 + 8, h // 2 + 8
+    x0, y0 = max(0, x - mx), max(0, y - my)
+    x1, y1 = min(frame_w, x + w + mx), min(frame_h, y + h + my)
+    x1 = x0 + max(step, (x1 - x0) // step * step)
+    y1 = y0 + max(step, (y1 - y0) // step * step)
+    return (x0, y0, min(x1, frame_w), min(y1, frame_h))
+
+
+def merge_regions(regions: List[Region]) -> List[Region]:
+    """Union overlapping windows so no pixel is searched twice in a frame."""
+    out: List[Region] = []
+    for r in sorted(regions):
+        if out and r[0] < out[-1][2] and r[1] < out[-1][3] and out[-1][1] < r[3]:
+            p = out.pop()
+            r = (min(p[0], r[0]), min(p[1], r[1]), max(p[2], r[2]), max(p[3], r[3]))
+        out.append(r)
+    return out
+
+
+class Pipeline:
+    """Range and bearing to every landmark in a frame.
+
+    Parameters
+    ----------
+    cfg : Config
+        Validated configuration (camera intrinsics, landmark, detection, model).
+    track : bool, optional
+        Search only around last frame's landmarks between full-frame scans.
+        ``None`` takes ``cfg.detection.tracking``. Use ``False`` for frames
+        that are not a sequence.
+    """
+
+    def __init__(self, cfg: Config, track: Optional[bool] = None) -> None:
+        self.cfg = cfg
+        self.track = cfg.detection.tracking if track is None else track
+        self.limits = PairingLimits()
+        self._cams: Dict[Tuple[int, int], Tuple[CameraIntrinsics, int]] = {}
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget tracked landmarks; the next frame gets a full-frame search."""
+        self._tracks: List[BBox] = []
+        self._since_scan = 0
+        self._gains: Gains = UNIT_GAINS
+
+    def _camera(self, w: int, h: int) -> Tuple[CameraIntrinsics, int]:
+        """Intrinsics for this frame size and the band-preserving filter size."""
+        key = (w, h)
+        if key not in self._cams:
+            cam = self.cfg.camera
+            if (cam.width_px, cam.height_px) != key:
+                cam = cam.scaled(w, h)
+            far = self.cfg.model.envelope_range_m[1]
+            band_px = cam.fy_px * self.cfg.landmark.band_height_m / far / self.cfg.detection.downscale
+            self._cams[key] = (cam, band_preserving_ksize(self.cfg.detection.median_ksize, band_px))
+        return self._cams[key]
+
+    def process(self, frame: np.ndarray) -> FrameResult:
+        """Find every landmark in a BGR uint8 frame; nearest first.
+
+        Raises
+        ------
+        FrameError
+            The frame is not a non-empty H×W×3 uint8 array.
+        """
+        bgr = check_frame(frame)
+        h, w = bgr.shape[:2]
+        cam, ksize = self._camera(w, h)
+        det = self.cfg.detection
+        tracked = False
+        if det.method == "paper":
+            found = detect_paper(bgr, det)
+        else:
+            s = det.downscale
+            full = (0, 0, w // s * s, h // s * s)
+            if self.track and self._tracks and self._since_scan < det.full_scan_every - 1:
+                regions = merge_regions([grow(b, w, h, s) for b in self._tracks])
+                self._since_scan += 1
+                tracked = True
+            else:
+                if det.white_balance == "grey_world":
+                    self._gains = grey_world_gains(bgr[::8, ::8])
+                regions = [full]
+                self._since_scan = 0
+            found = []
+            for region in regions:
+                found.extend(detect_region(bgr, region, det, self._gains, ksize, self.limits, self.cfg.landmark))
+        landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)
+        self._tracks = [lm.bbox_px for lm in landmarks] if self.track else []
+        return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
+
+    def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:
+        rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, self.cfg.model, self.cfg.landmark)
+        return Landmark(
+            range_m=rng,
+            bearing_rad=bearing,
+            d_v_m=d_v,
+            d_h_m=d_h,
+            l_px=l_px,
+            red_xy_px=c.red_xy_px,
+            blue_xy_px=c.blue_xy_px,
+            width_px=c.width_px,
+            bbox_px=c.bbox_px,
+            in_envelope=in_envelope(rng, bearing, self.cfg.model),
+        )

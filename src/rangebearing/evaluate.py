@@ -1,0 +1,115 @@
+"""Accuracy of readings against ground truth: matching and the report ``replay --truth`` prints."""
+
+from __future__ import annotations
+
+import math
+from typing import Iterable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ._compat import frozen
+from .core.types import Landmark
+from .truth import TruthRow
+
+MATCH_GAP_RAD = math.radians(3.0)
+
+
+@frozen
+class Match:
+    """A true landmark and the detection matched to it (``None`` when missed)."""
+
+    frame: str
+    truth: TruthRow
+    found: Optional[Landmark]
+
+    @property
+    def range_err_pct(self) -> float:
+        assert self.found is not None
+        return 100.0 * abs(self.found.range_m - self.truth.range_m) / self.truth.range_m
+
+    @property
+    def bearing_err_deg(self) -> float:
+        assert self.found is not None
+        return math.degrees(abs(self.found.bearing_rad - self.truth.bearing_rad))
+
+
+def match_frame(
+    frame: str, found: Sequence[Landmark], truths: Sequence[TruthRow], gap_rad: float = MATCH_GAP_RAD
+) -> Tuple[List[Match], List[Landmark]]:
+    """Match detections to truth by bearing, closest pairs first, each used once.
+
+    Returns the matches (one per true landmark, ``found=None`` when missed)
+    and the detections left over, which are false landmarks.
+    """
+    pairs = sorted(
+        (abs(f.bearing_rad - t.bearing_rad), i, j)
+        for i, f in enumerate(found)
+        for j, t in enumerate(truths)
+        if abs(f.bearing_rad - t.bearing_rad) <= gap_rad
+    )
+    used_f, by_truth = set(), {}
+    for _gap, i, j in pairs:
+        if i in used_f or j in by_truth:
+            continue
+        used_f.add(i)
+        by_truth[j] = found[i]
+    matches = [Match(frame, t, by_truth.get(j)) for j, t in enumerate(truths)]
+    false = [f for i, f in enumerate(found) if i not in used_f]
+    return matches, false
+
+
+@frozen
+class AccuracyReport:
+    """Detection rate, false landmarks and error statistics over a set of frames."""
+
+    frames: int
+    truths: int
+    detected: int
+    false_landmarks: int
+    range_err_pct_mean: float
+    range_err_pct_p95: float
+    bearing_err_deg_mean: float
+    bearing_err_deg_p95: float
+
+    @property
+    def detection_rate(self) -> float:
+        return self.detected / self.truths if self.truths else 1.0
+
+
+def accuracy(frames: Iterable[Tuple[str, Sequence[Landmark], Sequence[TruthRow]]]) -> Tuple[AccuracyReport, List[Match]]:
+    """Evaluate ``(frame, detections, truths)`` triples; returns the report and every match."""
+    matches: List[Match] = []
+    n_frames = n_false = 0
+    for name, found, truths in frames:
+        n_frames += 1
+        m, false = match_frame(name, found, truths)
+        matches.extend(m)
+        n_false += len(false)
+    hits = [m for m in matches if m.found is not None]
+    r = np.array([m.range_err_pct for m in hits]) if hits else np.array([math.nan])
+    b = np.array([m.bearing_err_deg for m in hits]) if hits else np.array([math.nan])
+    report = AccuracyReport(
+        frames=n_frames,
+        truths=len(matches),
+        detected=len(hits),
+        false_landmarks=n_false,
+        range_err_pct_mean=float(np.mean(r)),
+        range_err_pct_p95=float(np.percentile(r, 95)),
+        bearing_err_deg_mean=float(np.mean(b)),
+        bearing_err_deg_p95=float(np.percentile(b, 95)),
+    )
+    return report, matches
+
+
+def format_report(rep: AccuracyReport) -> str:
+    """A short human-readable accuracy report."""
+    return "\n".join(
+        [
+            f"frames            {rep.frames}",
+            f"landmarks (truth) {rep.truths}",
+            f"detected          {rep.detected} ({100.0 * rep.detection_rate:.1f} %)",
+            f"false landmarks   {rep.false_landmarks}",
+            f"range error       mean {rep.range_err_pct_mean:.2f} %   p95 {rep.range_err_pct_p95:.2f} %",
+            f"bearing error     mean {rep.bearing_err_deg_mean:.3f}°  p95 {rep.bearing_err_deg_p95:.3f}°",
+        ]
+    )

@@ -1,0 +1,330 @@
+"""Wire format v1: one compact UTF-8 JSON object per UDP datagram, one per frame.
+
+A datagram is sent for every processed frame, landmarks or not, so it doubles
+as a heartbeat. Landmarks travel *column-wise*: ``"landmarks"`` is an object
+whose keys are the unit-named fields and whose values are equal-length arrays,
+one entry per landmark. Writing each landmark as its own object would repeat
+~100 bytes of key names per landmark and push ten landmarks past one Ethernet
+MTU; column-wise, ten fit in about 1 kB. ``docs/protocol.md`` is the consumer
+documentation; ``schema/reading-v1.json`` is the JSON Schema.
+
+Encoding and decoding are pure functions: no sockets, no clocks.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import operator
+from typing import Any, Callable, Dict, Iterable, List, Optional, Protocol, Tuple
+
+from .._compat import frozen
+from ..errors import ProtocolError
+
+PROTOCOL_VERSION = 1
+MAX_DATAGRAM_BYTES = 65507  # the largest UDP payload over IPv4
+
+# Rounding on the wire: 0.1 mm, 1e-5 rad (0.0006 degrees), 0.01 px, 1 µs.
+M_DIGITS = 4
+RAD_DIGITS = 5
+PX_DIGITS = 2
+T_DIGITS = 6
+FPS_DIGITS = 2
+
+XY = Tuple[float, float]
+
+# The landmark columns in wire order; every one is required in v1.
+LANDMARK_FIELDS = (
+    "range_m", "bearing_rad", "in_envelope", "l_px", "d_v_m", "d_h_m",
+    "red_px", "blue_px", "width_px",
+)
+READING_FIELDS = ("v", "robot", "seq", "t", "landmarks")  # required
+OPTIONAL_FIELDS = ("fps", "dropped")
+
+
+class LandmarkLike(Protocol):
+    """What the encoder reads from a landmark (:class:`~rangebearing.core.types.Landmark`
+    and :class:`RemoteLandmark` both qualify)."""
+
+    @property
+    def range_m(self) -> float: ...
+    @property
+    def bearing_rad(self) -> float: ...
+    @property
+    def in_envelope(self) -> bool: ...
+    @property
+    def l_px(self) -> float: ...
+    @property
+    def d_v_m(self) -> float: ...
+    @property
+    def d_h_m(self) -> float: ...
+    @property
+    def red_xy_px(self) -> XY: ...
+    @property
+    def blue_xy_px(self) -> XY: ...
+    @property
+    def width_px(self) -> float: ...
+
+
+@frozen
+class RemoteLandmark:
+    """One landmark as another robot reported it (same units as ``Landmark``)."""
+
+    range_m: float
+    bearing_rad: float
+    in_envelope: bool
+    l_px: float
+    d_v_m: float
+    d_h_m: float
+    red_xy_px: XY
+    blue_xy_px: XY
+    width_px: float
+
+
+@frozen
+class Reading:
+    """One decoded datagram: what ``robot`` saw in frame ``seq`` captured at ``t``.
+
+    ``t`` is the capture time in Unix seconds on the sender's clock. ``fps`` and
+    ``dropped`` are ``None`` when the sender did not include them. ``sender`` is
+    the ``(host, port)`` the datagram came from, when known.
+    """
+
+    robot: str
+    seq: int
+    t: float
+    landmarks: Tuple[RemoteLandmark, ...] = ()
+    fps: Optional[float] = None
+    dropped: Optional[int] = None
+    sender: Optional[Tuple[str, int]] = None
+
+    def to_bytes(self) -> bytes:
+        """Encode this reading again (``sender`` is not part of the datagram)."""
+        return encode_reading(self.robot, self.seq, self.t, self.landmarks, self.fps, self.dropped)
+
+
+# --- encoding ---------------------------------------------------------------
+
+
+def _num(x: Any, digits: int, what: str) -> float:
+    v = float(x)
+    if not math.isfinite(v):
+        raise ProtocolError(f"cannot encode {what}={v!r}: not a finite number")
+    return round(v, digits) + 0.0  # + 0.0 turns -0.0 into 0.0
+
+
+def _count(n: Any, what: str) -> int:
+    try:
+        i = operator.index(n)
+    except TypeError:
+        raise ProtocolError(f"{what} must be an integer >= 0, got {n!r}") from None
+    if isinstance(n, bool) or i < 0:
+        raise ProtocolError(f"{what} must be an integer >= 0, got {n!r}")
+    return i
+
+
+def _xy(p: Any, what: str) -> List[float]:
+    x, y = p
+    return [_num(x, PX_DIGITS, what), _num(y, PX_DIGITS, what)]
+
+
+def encode_reading(
+    robot: str,
+    seq: int,
+    t: float,
+    landmarks: Iterable[LandmarkLike] = (),
+    fps: Optional[float] = None,
+    dropped: Optional[int] = None,
+) -> bytes:
+    """Encode one frame's landmarks as a v1 datagram.
+
+    Parameters
+    ----------
+    robot : str
+        Sender id (``publish.robot_id``), non-empty.
+    seq : int
+        The sender's count of processed frames, >= 0.
+    t : float
+        Capture time, Unix seconds.
+    landmarks : iterable of Landmark or RemoteLandmark
+        Everything seen in the frame; empty is a heartbeat.
+    fps, dropped : float, int, optional
+        Frame statistics; left out of the datagram when ``None``.
+
+    Returns
+    -------
+    bytes
+        Compact ASCII JSON. Metres are rounded to 0.1 mm, radians to 1e-5,
+        pixels to 0.01 px, ``t`` to 1 µs, ``fps`` to 0.01.
+
+    Raises
+    ------
+    ProtocolError
+        An argument cannot be represented (empty robot id, negative seq,
+        a NaN or infinite number).
+    """
+    if not isinstance(robot, str) or not robot:
+        raise ProtocolError(f"robot id must be a non-empty string, got {robot!r}")
+    cols: Dict[str, List[Any]] = {name: [] for name in LANDMARK_FIELDS}
+    for lm in landmarks:
+        cols["range_m"].append(_num(lm.range_m, M_DIGITS, "range_m"))
+        cols["bearing_rad"].append(_num(lm.bearing_rad, RAD_DIGITS, "bearing_rad"))
+        cols["in_envelope"].append(bool(lm.in_envelope))
+        cols["l_px"].append(_num(lm.l_px, PX_DIGITS, "l_px"))
+        cols["d_v_m"].append(_num(lm.d_v_m, M_DIGITS, "d_v_m"))
+        cols["d_h_m"].append(_num(lm.d_h_m, M_DIGITS, "d_h_m"))
+        cols["red_px"].append(_xy(lm.red_xy_px, "red_px"))
+        cols["blue_px"].append(_xy(lm.blue_xy_px, "blue_px"))
+        cols["width_px"].append(_num(lm.width_px, PX_DIGITS, "width_px"))
+    msg: Dict[str, Any] = {
+        "v": PROTOCOL_VERSION,
+        "robot": robot,
+        "seq": _count(seq, "seq"),
+        "t": _num(t, T_DIGITS, "t"),
+        "landmarks": cols,
+    }
+    if fps is not None:
+        msg["fps"] = _num(fps, FPS_DIGITS, "fps")
+    if dropped is not None:
+        msg["dropped"] = _count(dropped, "dropped")
+    return json.dumps(msg, separators=(",", ":"), allow_nan=False).encode("ascii")
+
+
+# --- decoding ---------------------------------------------------------------
+
+
+def _reject_constant(name: str) -> Any:
+    raise ProtocolError(f"{name} is not allowed in a reading")
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _number(v: Any, where: str, lo: float = -math.inf) -> float:
+    if not _is_number(v) or v < lo:
+        bound = "" if lo == -math.inf else f" >= {lo:g}"
+        raise ProtocolError(f"{where}: expected a finite number{bound}, got {v!r}")
+    return float(v)
+
+
+def _integer(v: Any, where: str) -> int:
+    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+        raise ProtocolError(f"{where}: expected an integer >= 0, got {v!r}")
+    return v
+
+
+def _boolean(v: Any, where: str) -> bool:
+    if not isinstance(v, bool):
+        raise ProtocolError(f"{where}: expected true or false, got {v!r}")
+    return v
+
+
+def _point(v: Any, where: str) -> XY:
+    if not isinstance(v, list) or len(v) != 2:
+        raise ProtocolError(f"{where}: expected [x, y], got {v!r}")
+    return (_number(v[0], where), _number(v[1], where))
+
+
+def _bearing(v: Any, where: str) -> float:
+    b = _number(v, where)
+    if not -math.pi <= b <= math.pi:
+        raise ProtocolError(f"{where}: {b!r} is outside [-pi, pi]")
+    return b
+
+
+def _size(v: Any, where: str) -> float:
+    return _number(v, where, 0.0)
+
+
+_COLUMN_CHECKS: Dict[str, Callable[[Any, str], Any]] = {
+    "range_m": _size,
+    "bearing_rad": _bearing,
+    "in_envelope": _boolean,
+    "l_px": _size,
+    "d_v_m": _number,
+    "d_h_m": _number,
+    "red_px": _point,
+    "blue_px": _point,
+    "width_px": _size,
+}
+
+
+def _landmarks(cols: Any) -> Tuple[RemoteLandmark, ...]:
+    if not isinstance(cols, dict):
+        raise ProtocolError(f"landmarks: expected an object of columns, got {type(cols).__name__}")
+    missing = [name for name in LANDMARK_FIELDS if name not in cols]
+    if missing:
+        raise ProtocolError(f"landmarks: missing column(s) {', '.join(missing)}")
+    n: Optional[int] = None
+    values: Dict[str, List[Any]] = {}
+    for name in LANDMARK_FIELDS:
+        col = cols[name]
+        if not isinstance(col, list):
+            raise ProtocolError(f"landmarks.{name}: expected an array, got {type(col).__name__}")
+        if n is not None and len(col) != n:
+            raise ProtocolError(f"landmarks.{name}: {len(col)} entries, other columns have {n}")
+        n = len(col)
+        check = _COLUMN_CHECKS[name]
+        values[name] = [check(v, f"landmarks.{name}[{i}]") for i, v in enumerate(col)]
+    return tuple(
+        RemoteLandmark(
+            range_m=values["range_m"][i],
+            bearing_rad=values["bearing_rad"][i],
+            in_envelope=values["in_envelope"][i],
+            l_px=values["l_px"][i],
+            d_v_m=values["d_v_m"][i],
+            d_h_m=values["d_h_m"][i],
+            red_xy_px=values["red_px"][i],
+            blue_xy_px=values["blue_px"][i],
+            width_px=values["width_px"][i],
+        )
+        for i in range(n or 0)
+    )
+
+
+def decode_reading(data: bytes, sender: Optional[Tuple[str, int]] = None) -> Reading:
+    """Decode and check one datagram.
+
+    Types and required fields are checked strictly; unknown extra fields (at
+    the top level or as extra landmark columns) are ignored, so v1 readers
+    keep working when v1 writers add fields.
+
+    Raises
+    ------
+    ProtocolError
+        The datagram is not UTF-8 JSON, not an object, not a rangebearing
+        reading, of another version, or has a missing or ill-typed field.
+    """
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise ProtocolError(f"expected bytes, got {type(data).__name__}")
+    if len(data) > MAX_DATAGRAM_BYTES:
+        raise ProtocolError(f"datagram of {len(data)} bytes is larger than any UDP payload")
+    try:
+        msg = json.loads(bytes(data).decode("utf-8"), parse_constant=_reject_constant)
+    except UnicodeDecodeError:
+        raise ProtocolError("datagram is not UTF-8 text") from None
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
+        if isinstance(exc, ProtocolError):
+            raise
+        raise ProtocolError(f"datagram is not JSON: {exc}") from None
+    if not isinstance(msg, dict) or "v" not in msg:
+        raise ProtocolError("not a rangebearing reading (no \"v\" field)")
+    v = msg["v"]
+    if v != PROTOCOL_VERSION or isinstance(v, bool) or not isinstance(v, int):
+        raise ProtocolError(f"unsupported protocol version {v!r} (this reader speaks v1)")
+    missing = [name for name in READING_FIELDS if name not in msg]
+    if missing:
+        raise ProtocolError(f"missing field(s) {', '.join(missing)}")
+    robot = msg["robot"]
+    if not isinstance(robot, str) or not robot:
+        raise ProtocolError(f"robot: expected a non-empty string, got {robot!r}")
+    return Reading(
+        robot=robot,
+        seq=_integer(msg["seq"], "seq"),
+        t=_number(msg["t"], "t"),
+        landmarks=_landmarks(msg["landmarks"]),
+        fps=_number(msg["fps"], "fps", 0.0) if "fps" in msg else None,
+        dropped=_integer(msg["dropped"], "dropped") if "dropped" in msg else None,
+        sender=sender,
+    )

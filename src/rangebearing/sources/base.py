@@ -1,0 +1,154 @@
+"""The one interface every frame source implements, the frame it yields, and the factory.
+
+A :class:`FrameSource` behaves like a camera: ``read()`` hands back the newest
+frame available, counting the ones it had to skip in ``dropped``. Sources are
+passed to the daemon and the CLI, never looked up from globals; the recorded
+source plays the part of gpiozero's mock pin backend.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Optional, Protocol, runtime_checkable
+
+import cv2
+import numpy as np
+
+from .._compat import frozen
+from ..errors import FrameError, SourceError
+
+if TYPE_CHECKING:
+    from ..config import SourceConfig
+    from ..core.types import CameraIntrinsics
+
+
+@frozen
+class Frame:
+    """One camera frame.
+
+    ``image`` is H×W×3 uint8 in OpenCV's BGR order. ``t_mono_ns`` is the capture
+    time on CLOCK_MONOTONIC (``time.monotonic_ns()``), the sensor timestamp where
+    the source has one. ``index`` is the source's own 0-based frame counter, so a
+    gap means frames were dropped upstream. ``name`` is the file name for image
+    directories and ``str(index)`` (the position in the file) otherwise.
+    """
+
+    image: np.ndarray
+    t_mono_ns: int
+    index: int
+    name: str
+
+
+@runtime_checkable
+class FrameSource(Protocol):
+    """Where frames come from: Picamera2, OpenCV capture, recorded files, synthetic scenes."""
+
+    def open(self) -> None:
+        """Start delivering frames; SourceError/CameraError when that is impossible.
+
+        Calling it on a source that is already open does nothing.
+        """
+
+    def read(self) -> Optional[Frame]:
+        """The newest frame available, or None at the end of the stream.
+
+        Raises FrameError for one bad frame (the next read goes on) and
+        SourceError/CameraError when the source has failed.
+        """
+
+    def close(self) -> None:
+        """Stop and release everything; safe to call twice."""
+
+    @property
+    def dropped(self) -> int:
+        """Frames that arrived but were overwritten before ``read()`` took them."""
+
+
+def validate_frame(image: object) -> np.ndarray:
+    """Check a decoded image and return it as H×W×3 uint8 BGR.
+
+    Parameters
+    ----------
+    image : object
+        What a decoder or camera produced. Accepted: uint8 arrays of shape
+        (H, W) or (H, W, 1) (grey, expanded to BGR), (H, W, 3) (BGR, returned
+        as is) and (H, W, 4) (OpenCV BGRA / Picamera2 ``XRGB8888``, whose
+        fourth byte is alpha or padding and is dropped). Picamera2's
+        ``XBGR8888`` arrives as [R, G, B, X] and must be swapped by the caller;
+        no array shape can tell the two apart.
+
+    Returns
+    -------
+    numpy.ndarray
+        (H, W, 3) uint8, C-contiguous.
+
+    Raises
+    ------
+    FrameError
+        ``image`` is None, not an array, empty, not uint8, or of another shape.
+    """
+    if image is None:
+        raise FrameError("no image (the decoder or camera returned None)")
+    if not isinstance(image, np.ndarray):
+        raise FrameError(f"expected a numpy image, got {type(image).__name__}")
+    if image.size == 0:
+        raise FrameError(f"empty image of shape {image.shape}")
+    if image.dtype != np.uint8:
+        raise FrameError(f"expected uint8 pixels, got {image.dtype}")
+    if image.ndim == 3 and image.shape[2] == 1:
+        image = image[:, :, 0]
+    if image.ndim == 2:
+        return cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_GRAY2BGR)
+    if image.ndim != 3 or image.shape[2] not in (3, 4):
+        raise FrameError(f"expected H×W, H×W×3 or H×W×4 pixels, got shape {image.shape}")
+    if image.shape[2] == 4:
+        image = image[:, :, :3]
+    return np.ascontiguousarray(image)
+
+
+def open_source(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
+    """Build the source ``cfg.kind`` names, open it and return it.
+
+    ``camera`` sizes the synthetic renderer; the other sources take their size
+    from ``cfg``. Opening an already open source is a no-op, so a caller that
+    calls ``open()`` again is harmless. The caller owns the source and must
+    ``close()`` it.
+
+    Raises
+    ------
+    SourceError
+        The kind is unknown or not available, or the source cannot be opened
+        (CameraError for a missing or busy camera).
+    """
+    source: FrameSource
+    if cfg.kind == "recorded":
+        from .recorded import RecordedSource
+
+        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop)
+    elif cfg.kind == "opencv":
+        from .opencv_capture import OpenCVSource
+
+        source = OpenCVSource(
+            cfg.device, cfg.width_px, cfg.height_px, cfg.fps,
+            timeout_s=cfg.timeout_s, retries=cfg.retries,
+        )
+    elif cfg.kind == "picamera2":
+        from .picamera2_source import Picamera2Source
+
+        source = Picamera2Source(cfg)
+    elif cfg.kind == "synthetic":
+        source = _synthetic(cfg, camera)
+    else:
+        raise SourceError(f"unknown source kind {cfg.kind!r}")
+    source.open()
+    return source
+
+
+def _synthetic(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
+    try:
+        from .synthetic import SyntheticSource
+    except ImportError:
+        raise SourceError(
+            "source kind 'synthetic' is not available yet (rangebearing.synth is missing); "
+            "use 'recorded' with rendered frames instead"
+        ) from None
+    return SyntheticSource(cfg, camera)

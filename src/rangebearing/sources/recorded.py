@@ -1,0 +1,281 @@
+"""Recorded frames: a directory of images or a video file, read lazily, paced like a camera."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Callable, Dict, Iterator, List, Optional, Tuple, Union
+
+import cv2
+import numpy as np
+
+from ..errors import FrameError, SourceError
+from .base import Frame
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
+PathLike = Union[str, Path]
+_CACHE_BYTES = 64 * 1024 * 1024  # decoded frames kept for looping: ~70 VGA frames
+
+
+def list_images(directory: Path) -> List[Path]:
+    """Image files in ``directory`` sorted by name; other files (truth.csv…) are ignored."""
+    return sorted(
+        (p for p in directory.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
+        key=lambda p: p.name,
+    )
+
+
+def _decode(path: Path) -> Optional[np.ndarray]:
+    # imdecode of the raw bytes rather than imread: works with any file name
+    # and returns None (not an exception) for a corrupt file.
+    try:
+        data = np.fromfile(str(path), dtype=np.uint8)
+    except OSError:
+        return None
+    if data.size == 0:
+        return None
+    return cv2.imdecode(data, cv2.IMREAD_COLOR)
+
+
+def _check_path(path: PathLike) -> Path:
+    p = Path(path)
+    if not str(path):
+        raise SourceError("no recording path given (source.path is empty)")
+    if not p.exists():
+        raise SourceError(f"{p}: no such file or directory")
+    if p.is_dir() and not list_images(p):
+        raise SourceError(f"{p}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
+    return p
+
+
+def _open_video(path: Path) -> cv2.VideoCapture:
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        cap.release()
+        raise SourceError(f"{path}: OpenCV cannot open this as a video")
+    return cap
+
+
+def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
+    """Yield ``(name, image)`` for every recorded frame, decoding one at a time.
+
+    A directory yields its images sorted by file name, an unreadable image as
+    ``(name, None)``; a video yields ``(str(i), image)`` for frame ``i``.
+
+    Raises
+    ------
+    SourceError
+        The path does not exist, the directory holds no images, or OpenCV
+        cannot open the video.
+    """
+    p = _check_path(path)
+    if p.is_dir():
+        for img_path in list_images(p):
+            yield img_path.name, _decode(img_path)
+        return
+    cap = _open_video(p)
+    try:
+        i = 0
+        while True:
+            ok, image = cap.read()
+            if not ok:
+                return
+            yield str(i), image
+            i += 1
+    finally:
+        cap.release()
+
+
+def count_recorded(path: PathLike) -> Optional[int]:
+    """How many frames :func:`iter_recorded` will yield, or None if the video does not say."""
+    p = _check_path(path)
+    if p.is_dir():
+        return len(list_images(p))
+    cap = _open_video(p)
+    try:
+        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+    finally:
+        cap.release()
+    return n if n > 0 else None
+
+
+class _EndOfVideo:
+    """Returned by a reader asked for a position past the end."""
+
+
+_END = _EndOfVideo()
+Fetched = Union[Optional[np.ndarray], _EndOfVideo]
+
+
+class _ImageDir:
+    """Random access to a directory's images, with a bounded cache when looping."""
+
+    def __init__(self, directory: Path, cache: bool) -> None:
+        self.paths = list_images(directory)
+        self.length: Optional[int] = len(self.paths)
+        self._cache: Optional[Dict[int, Optional[np.ndarray]]] = {} if cache else None
+        self._cached_bytes = 0
+
+    def name(self, pos: int) -> str:
+        return self.paths[pos].name
+
+    def get(self, pos: int) -> Fetched:
+        if self._cache is not None and pos in self._cache:
+            return self._cache[pos]
+        image = _decode(self.paths[pos])
+        if self._cache is not None:
+            size = 0 if image is None else image.nbytes
+            if self._cached_bytes + size <= _CACHE_BYTES:
+                self._cache[pos] = image
+                self._cached_bytes += size
+        return image
+
+    def close(self) -> None:
+        self._cache = None
+
+
+class _Video:
+    """Sequential access to a video; seeking backwards reopens, skipping grabs."""
+
+    def __init__(self, path: Path) -> None:
+        self._path = path
+        self._cap: Optional[cv2.VideoCapture] = _open_video(path)
+        self._pos = 0  # position of the frame the capture returns next
+        self.length: Optional[int] = None  # learned when the end is reached
+
+    def name(self, pos: int) -> str:
+        return str(pos)
+
+    def get(self, pos: int) -> Fetched:
+        if self._cap is None or pos < self._pos:
+            self.close()
+            self._cap = _open_video(self._path)
+            self._pos = 0
+        while self._pos < pos:
+            if not self._cap.grab():
+                self.length = self._pos
+                return _END
+            self._pos += 1
+        ok, image = self._cap.read()
+        if not ok:
+            self.length = pos
+            return _END
+        self._pos += 1
+        return image
+
+    def close(self) -> None:
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+
+
+class RecordedSource:
+    """Recorded frames served like a live camera.
+
+    With ``fps`` set, frame *i* is "captured" at ``open() + i/fps``: ``read()``
+    waits for the next frame when the consumer is early, and when it is late
+    returns the newest frame already due, counting the skipped ones in
+    :attr:`dropped`. With ``fps`` None or 0 it serves every frame as fast as
+    the consumer reads and never drops. ``loop`` restarts at the end;
+    ``Frame.index`` keeps counting across loops while ``Frame.name`` names the
+    file (or the position in the video). ``clock`` (ns) and ``sleep`` (s) are
+    injectable so tests can pace without real time passing.
+    """
+
+    def __init__(
+        self,
+        path: PathLike,
+        fps: Optional[float] = None,
+        loop: bool = False,
+        clock: Callable[[], int] = time.monotonic_ns,
+        sleep: Callable[[float], None] = time.sleep,
+    ) -> None:
+        self._path = path
+        self._fps = float(fps) if fps else 0.0
+        self._loop = loop
+        self._clock = clock
+        self._sleep = sleep
+        self._reader: Union[_ImageDir, _Video, None] = None
+        self._start_ns = 0
+        self._next = 0
+        self._dropped = 0
+
+    @property
+    def dropped(self) -> int:
+        return self._dropped
+
+    def open(self) -> None:
+        """Check the recording and start the virtual camera clock."""
+        if self._reader is not None:
+            return
+        p = _check_path(self._path)
+        self._reader = _ImageDir(p, cache=self._loop) if p.is_dir() else _Video(p)
+        self._start_ns = self._clock()
+        self._next = 0
+        self._dropped = 0
+
+    def close(self) -> None:
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None
+
+    def read(self) -> Optional[Frame]:
+        """The next (paced: newest due) frame; None at the end; FrameError for a corrupt one."""
+        reader = self._reader
+        if reader is None:
+            raise SourceError("recorded source is not open")
+        i = self._next
+        if self._fps > 0:
+            i = self._pace(i, reader.length)
+        fetched = self._fetch(reader, i)
+        last = None if reader.length is None else reader.length - 1
+        if fetched is None and i > self._next and last is not None and self._next <= last < i:
+            # A paced skip ran past the end of a video whose length was unknown:
+            # deliver its last frame, as a camera would have.
+            self._dropped -= i - last
+            i = last
+            fetched = self._fetch(reader, i)
+        if fetched is None:
+            return None
+        pos, image = fetched
+        self._next = i + 1
+        name = reader.name(pos)
+        if image is None:
+            raise FrameError(f"{name}: cannot decode image")
+        t_ns = self._capture_ns(i) if self._fps > 0 else self._clock()
+        return Frame(image=image, t_mono_ns=t_ns, index=i, name=name)
+
+    def _capture_ns(self, i: int) -> int:
+        return self._start_ns + round(i * 1e9 / self._fps)
+
+    def _pace(self, i: int, length: Optional[int]) -> int:
+        """Index of the frame to deliver: wait for ``i`` if it is not due, else the newest due."""
+        now = self._clock()
+        due = math.floor((now - self._start_ns) * self._fps / 1e9)
+        if due >= i:
+            if not self._loop and length is not None:
+                due = min(due, max(i, length - 1))  # the stream ended while we were busy
+            self._dropped += due - i
+            return due
+        t_due = self._capture_ns(i)
+        while now < t_due:
+            self._sleep((t_due - now) / 1e9)
+            now = self._clock()
+        return i
+
+    def _fetch(self, reader: Union[_ImageDir, _Video], i: int) -> Optional[Tuple[int, Optional[np.ndarray]]]:
+        for _ in range(2):  # a second try once a video's length has been learned
+            length = reader.length
+            if length is not None:
+                if length == 0 or (i >= length and not self._loop):
+                    return None
+                pos = i % length
+            else:
+                pos = i
+            image = reader.get(pos)
+            if not isinstance(image, _EndOfVideo):
+                return pos, image
+            if not self._loop:
+                return None
+        return None

@@ -1,0 +1,53 @@
+import cv2
+import numpy as np
+import pytest
+
+from rangebearing.core.denoise import band_preserving_ksize, majority_filter, median_filter
+
+
+@pytest.mark.parametrize("k", [3, 5, 7, 15])
+def test_majority_equals_median_on_binary_masks_away_from_borders(k):
+    rng = np.random.default_rng(k)
+    mask = ((rng.random((60, 80)) < 0.45) * 255).astype(np.uint8)
+    got = majority_filter(mask, k)
+    want = cv2.medianBlur(mask, k)
+    m = k // 2
+    assert np.array_equal(got[m:-m, m:-m], want[m:-m, m:-m])
+
+
+def test_majority_removes_isolated_pixels_and_keeps_solid_regions():
+    mask = np.zeros((20, 20), np.uint8)
+    mask[5, 5] = 255  # salt
+    mask[10:16, 4:16] = 255  # a solid band 6 px tall
+    out = majority_filter(mask, 5)
+    assert out[5, 5] == 0
+    assert out[12, 10] == 255 and out[13, 10] == 255
+
+
+def test_ksize_one_is_identity():
+    mask = np.eye(5, dtype=np.uint8) * 255
+    assert majority_filter(mask, 1) is mask
+    img = np.zeros((5, 5, 3), np.uint8)
+    assert median_filter(img, 1) is img
+
+
+@pytest.mark.parametrize("band_px, expected", [(10.0, 15), (5.0, 9), (2.4, 3), (1.0, 1), (8.0, 15)])
+def test_band_preserving_ksize(band_px, expected):
+    assert band_preserving_ksize(15, band_px) == expected
+
+
+@pytest.mark.parametrize("h", [2, 3, 5, 8])
+def test_band_preserving_ksize_really_keeps_the_band(h):
+    k = band_preserving_ksize(15, h)
+    mask = np.zeros((40, 60), np.uint8)
+    mask[20 : 20 + h, 5:55] = 255
+    assert majority_filter(mask, k)[20 + h // 2, 30] == 255
+    too_big = k + 2
+    if too_big <= 15 and too_big >= 2 * h + 1:
+        assert majority_filter(mask, too_big)[20 + h // 2, 30] == 0
+
+
+def test_paper_median_15_erases_a_five_pixel_band():
+    img = np.full((60, 80, 3), 200, np.uint8)
+    img[30:35, 10:70] = (40, 40, 180)
+    assert (median_filter(img, 15)[32, 40] == 200).all()
