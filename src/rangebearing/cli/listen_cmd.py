@@ -1,0 +1,146 @@
+"""``rangebearing listen``: print readings as they arrive, like ``ros2 topic echo``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from typing import Any, Optional, TextIO
+
+from ..config import DEFAULT_PORT
+from ..net.client import Subscriber
+from ..net.protocol import Reading
+
+DESCRIPTION = """\
+Listen for rangebearing readings and print one line per frame:
+
+  zumo #1234 t=1732419876.123  2 landmarks: 0.412 m  +12.3° | 1.205 m  -4.0° (out of envelope)
+
+Bearings are positive to the left of the camera's optical axis. Every daemon
+sends a reading for every frame, so silence means no daemon is publishing here.
+Exits 0 on Ctrl-C or after --count readings, 1 if --timeout passes in silence.
+"""
+
+
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port number") from None
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{port} is not in 0-65535")
+    return port
+
+
+def _positive(kind: type) -> Any:
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a {kind.__name__}") from None
+        if not value > 0 or (isinstance(value, float) and not math.isfinite(value)):
+            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+        return value
+
+    return parse
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``listen`` subcommand to a ``parser.add_subparsers()`` object."""
+    p = subparsers.add_parser(
+        "listen",
+        help="print readings published by rangebearing daemons",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--port", type=_port, default=DEFAULT_PORT,
+                   help=f"UDP port to listen on (default {DEFAULT_PORT})")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="local address for unicast (default 127.0.0.1; "
+                        "0.0.0.0 hears robots on the network)")
+    p.add_argument("--group", default=None, metavar="G",
+                   help="join this IPv4 multicast group instead, e.g. 239.255.47.80")
+    p.add_argument("--interface", default=None, metavar="I",
+                   help="address of the interface to join --group on (default 127.0.0.1)")
+    p.add_argument("--json", action="store_true", help="print each datagram's raw JSON instead")
+    p.add_argument("--count", type=_positive(int), default=None, metavar="N",
+                   help="exit 0 after N readings")
+    p.add_argument("--timeout", type=_positive(float), default=None, metavar="S",
+                   help="exit 1 if no reading arrives for S seconds (default: wait forever)")
+    p.set_defaults(func=run)
+
+
+def format_reading(reading: Reading) -> str:
+    """One human-readable line for one reading."""
+    n = len(reading.landmarks)
+    head = f"{reading.robot} #{reading.seq} t={reading.t:.3f}  {n} landmark{'' if n == 1 else 's'}"
+    parts = []
+    for lm in reading.landmarks:
+        text = f"{lm.range_m:.3f} m  {math.degrees(lm.bearing_rad):+.1f}°"
+        parts.append(text if lm.in_envelope else f"{text} (out of envelope)")
+    line = f"{head}: {' | '.join(parts)}" if parts else head
+    extras = []
+    if reading.fps is not None:
+        extras.append(f"{reading.fps:.1f} fps")
+    if reading.dropped:
+        extras.append(f"{reading.dropped} dropped")
+    return f"{line}  [{', '.join(extras)}]" if extras else line
+
+
+def _error(message: str) -> int:
+    print(f"rangebearing: error: {message}", file=sys.stderr, flush=True)
+    return 1
+
+
+def _one_line_json(data: bytes) -> str:
+    text = data.decode("utf-8").strip()
+    if "\n" in text or "\r" in text:  # another writer pretty-printed it
+        text = json.dumps(json.loads(text), separators=(",", ":"), ensure_ascii=False)
+    return text
+
+
+def echo(
+    sub: Subscriber,
+    out: TextIO,
+    as_json: bool = False,
+    count: Optional[int] = None,
+    timeout_s: Optional[float] = None,
+) -> int:
+    """Print readings from ``sub`` to ``out``; 0 after ``count`` readings, 1 on a timeout."""
+    shown = 0
+    while count is None or shown < count:
+        got = sub.recv_datagram(timeout_s)
+        if got is None:
+            where = f"{sub.group or sub.address[0]}:{sub.port}"
+            return _error(f"no reading arrived on {where} within {timeout_s:g} s"
+                          + (f" ({sub.dropped} invalid datagrams dropped)" if sub.dropped else ""))
+        reading, data = got
+        line = _one_line_json(data) if as_json else format_reading(reading)
+        print(line, file=out, flush=True)
+        shown += 1
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``rangebearing listen`` with parsed arguments; returns the exit status."""
+    if args.interface is not None and not args.group:
+        return _error("--interface only applies with --group")
+    where = f"{args.group or args.host}:{args.port}"
+    try:
+        sub = Subscriber(port=args.port, host=args.host, group=args.group,
+                         interface=args.interface or "127.0.0.1")
+    except OSError as exc:
+        return _error(f"cannot listen on {where}: {exc.strerror or exc}")
+    try:
+        with sub:
+            return echo(sub, sys.stdout, args.json, args.count, args.timeout)
+    except KeyboardInterrupt:
+        return 0
+    except BrokenPipeError:
+        # The reader (e.g. `| head`) went away: stop quietly, and point stdout
+        # at /dev/null so the interpreter's final flush does not complain.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0

@@ -1,0 +1,113 @@
+"""``rangebearing run``: the onboard daemon (foreground, logs to stderr for journald)."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import logging
+import sys
+from typing import Any, Callable, Optional
+
+from ..config import Config, SourceConfig, load_config
+from ..daemon import Daemon
+from ..errors import ConfigError
+from ..net.protocol import decode_reading
+from ..net.publisher import UdpPublisher
+from ..sdnotify import Notifier
+from ..sources.base import FrameSource, open_source
+from .common import add_config_arg
+from .listen_cmd import format_reading
+
+log = logging.getLogger("rangebearing.run")
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "run",
+        help="run the daemon: camera → pipeline → UDP readings",
+        description="Read frames, find every landmark, publish range and bearing over UDP. Runs in the "
+        "foreground; SIGTERM/SIGINT stop it, SIGHUP reloads --config. Under systemd (Type=notify) it "
+        "reports READY=1 after the first frame and pings the watchdog while frames flow.",
+    )
+    add_config_arg(p)
+    add_source_args(p)
+    p.add_argument("--echo", action="store_true", help="print every reading sent, one line per frame")
+    p.add_argument("--json", action="store_true", help="with --echo, print the datagrams as sent")
+    p.add_argument("--check", action="store_true", help="validate the config and exit")
+    p.set_defaults(func=run)
+
+
+def add_source_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--source",
+        metavar="SPEC",
+        help="override the config's source: picamera2[:N], opencv:DEVICE (index, /dev/videoN, file, URL), "
+        "synthetic, or a directory of images / video file (recorded)",
+    )
+    p.add_argument("--fps", type=float, help="frame rate (recorded frames: pace; 0 = as fast as possible)")
+    p.add_argument("--loop", action="store_true", help="recorded frames: start again at the end")
+
+
+def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[SourceConfig]:
+    """The source named on the command line, or ``None`` when none was given."""
+    spec, fps, loop = getattr(args, "source", None), getattr(args, "fps", None), getattr(args, "loop", False)
+    if spec is None and fps is None and not loop:
+        return None
+    src = base
+    if spec:
+        kind, _, rest = spec.partition(":")
+        if kind == "picamera2":
+            src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest.isdigit() else src.camera_num)
+        elif kind == "opencv":
+            src = dataclasses.replace(src, kind="opencv", device=rest or src.device)
+        elif kind == "synthetic":
+            src = dataclasses.replace(src, kind="synthetic")
+        else:
+            src = dataclasses.replace(src, kind="recorded", path=rest if kind == "recorded" else spec)
+    if fps is not None:
+        if fps < 0:
+            raise ConfigError(["--fps: must be >= 0"], "command line")
+        src = dataclasses.replace(src, fps=fps)
+    if loop:
+        src = dataclasses.replace(src, loop=True)
+    if src.kind == "recorded" and not src.path:
+        raise ConfigError(["--source: recorded frames need a path"], "command line")
+    return src
+
+
+def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
+    return open_source(cfg.source, cfg.camera, sleep=sleep)
+
+
+def run(args: argparse.Namespace) -> int:
+    cfg = load_config(args.config) if args.config else Config()
+    override = source_from_args(args, cfg.source)
+    if override is not None:
+        cfg = dataclasses.replace(cfg, source=override)
+    if cfg.source.kind == "recorded" and not cfg.source.path:
+        raise ConfigError(["source.path: required when source.kind is 'recorded'"], cfg.source_file)
+    if args.check:
+        print(f"{cfg.source_file}: OK")
+        return 0
+    echo = None
+    if args.echo or cfg.daemon.echo:
+        echo = _echo_json if args.json else _echo_line
+    daemon = Daemon(
+        cfg, source_opener, UdpPublisher, Notifier(), config_path=args.config, echo=echo, source_override=override
+    )
+    daemon.install_signal_handlers()
+    dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)
+    if cfg.publish.multicast_group:
+        dests += f", multicast {cfg.publish.multicast_group}:{cfg.publish.multicast_port}"
+    log.info("starting: source %s, publishing to %s", cfg.source.kind, dests or "nowhere")
+    return daemon.run()
+
+
+def _echo_json(payload: bytes) -> None:
+    sys.stdout.write(payload.decode("utf-8") + "\n")
+    sys.stdout.flush()
+
+
+def _echo_line(payload: bytes) -> None:
+    sys.stdout.write(format_reading(decode_reading(payload)) + "\n")
+    sys.stdout.flush()

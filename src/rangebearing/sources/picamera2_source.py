@@ -1,0 +1,262 @@
+"""The Raspberry Pi camera through Picamera2, with the library's sharp edges handled.
+
+Written against picamera2 (raspberrypi/picamera2: picamera2/picamera2.py,
+request.py, job.py) and the manual "The Picamera2 Library":
+
+* ``Picamera2(n)`` looks ``n`` up in ``global_camera_info()``, so a missing
+  camera raises IndexError; a camera held by another process fails in
+  ``acquire()`` and surfaces as RuntimeError("Camera __init__ sequence did not
+  complete.").
+* ``capture_request()`` without ``wait=`` blocks forever. With ``wait=t`` the
+  job's Future raises ``concurrent.futures.TimeoutError`` (the builtin
+  TimeoutError only from Python 3.11) and the job stays queued: it would eat
+  the next frame and leak its request, and ``stop()`` would queue behind it, so
+  ``cancel_all_and_flush()`` must follow a timeout.
+* ``"RGB888"`` pixels are stored [B, G, R] (request.py maps RGB888 to PIL mode
+  "BGR"), i.e. already OpenCV order: no channel swap here.
+* Every request must be released or the camera runs out of buffers.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import importlib
+import logging
+import threading
+import time
+from typing import Any, Callable, Dict, Optional
+
+import numpy as np
+
+from ..config import SourceConfig
+from ..errors import CameraError, FrameError, SourceError
+from .base import Frame, validate_frame
+
+_log = logging.getLogger(__name__)
+
+INSTALL_HINT = "apt install python3-picamera2 and create the venv with --system-site-packages"
+_TIMEOUTS = (TimeoutError, concurrent.futures.TimeoutError)
+
+
+def camera_controls(cfg: SourceConfig) -> Dict[str, Any]:
+    """The libcamera controls for ``cfg``: a fixed frame rate, then ``cfg.controls`` on top.
+
+    ``FrameDurationLimits`` (µs, min and max) is what libcamera takes; newer
+    picamera2 also accepts ``FrameRate``, which it turns into the same thing.
+    """
+    frame_us = int(round(1e6 / cfg.fps))
+    controls: Dict[str, Any] = {"FrameDurationLimits": (frame_us, frame_us)}
+    user = dict(cfg.controls)
+    if "FrameRate" in user:
+        controls.pop("FrameDurationLimits")
+    controls.update(user)
+    return controls
+
+
+def sensor_to_monotonic_ns(sensor_ns: int, received_ns: int, boot_offset_ns: int) -> int:
+    """Put a ``SensorTimestamp`` on CLOCK_MONOTONIC.
+
+    libcamera's control_ids_core.yaml documents SensorTimestamp as CLOCK_BOOTTIME,
+    but the Pi pipeline copies the V4L2 buffer timestamp (CLOCK_MONOTONIC) and
+    picamera2 itself compares it with ``time.monotonic_ns()`` (``capture_request(
+    flush=...)`` in picamera2.py). The two clocks differ only by time spent in
+    suspend (``boot_offset_ns`` = BOOTTIME − MONOTONIC). A frame is always
+    exposed before it is received, so a stamp later than ``received_ns`` must be
+    BOOTTIME; if even the converted stamp is in the future, use ``received_ns``.
+    """
+    if sensor_ns <= received_ns:
+        return sensor_ns
+    converted = sensor_ns - boot_offset_ns
+    return converted if converted <= received_ns else received_ns
+
+
+def frames_missed(prev_ns: Optional[int], sensor_ns: int, period_ns: float) -> int:
+    """Frames lost between two sensor timestamps ``period_ns`` apart (0 for the first)."""
+    if prev_ns is None or period_ns <= 0:
+        return 0
+    return max(0, round((sensor_ns - prev_ns) / period_ns) - 1)
+
+
+def _boot_offset_ns() -> int:
+    boottime = getattr(time, "CLOCK_BOOTTIME", None)
+    if boottime is None:
+        return 0
+    return time.clock_gettime_ns(boottime) - time.monotonic_ns()
+
+
+def _import(name: str) -> Any:
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise CameraError(f"cannot import {name} ({exc}); {INSTALL_HINT}") from None
+
+
+class Picamera2Source:
+    """Frames from a Pi camera, BGR, stamped with the sensor time.
+
+    Opening retries with exponential back-off (``backoff_s``, doubling, capped
+    at ``max_backoff_s``) for ``cfg.retries`` more attempts when the camera is
+    missing or busy. A capture that times out (``cfg.timeout_s``) raises
+    FrameError; the ``cfg.retries``-th timeout in a row raises CameraError so
+    the daemon exits and systemd restarts it. ``close()`` gives stop/close
+    ``stop_timeout_s`` in a helper thread and logs if they hang.
+    """
+
+    def __init__(
+        self,
+        cfg: SourceConfig,
+        *,
+        sleep: Callable[[float], None] = time.sleep,
+        clock: Callable[[], int] = time.monotonic_ns,
+        backoff_s: float = 0.5,
+        max_backoff_s: float = 8.0,
+        stop_timeout_s: float = 3.0,
+    ) -> None:
+        self._cfg = cfg
+        self._sleep = sleep
+        self._clock = clock
+        self._backoff_s = backoff_s
+        self._max_backoff_s = max_backoff_s
+        self._stop_timeout_s = stop_timeout_s
+        self._cam: Any = None
+        self._width = cfg.width_px
+        self._boot_offset_ns = 0
+        self._prev_sensor_ns: Optional[int] = None
+        self._next_index = 0
+        self._dropped = 0
+        self._timeouts = 0
+
+    @property
+    def dropped(self) -> int:
+        return self._dropped
+
+    def open(self) -> None:
+        """Acquire, configure and start the camera; CameraError if it cannot be done."""
+        if self._cam is not None:
+            return
+        picamera2 = _import("picamera2")
+        libcamera = _import("libcamera")
+        cam = self._acquire(picamera2.Picamera2)
+        cfg = self._cfg
+        try:
+            config = cam.create_video_configuration(
+                main={"format": "RGB888", "size": (cfg.width_px, cfg.height_px)},
+                controls=camera_controls(cfg),
+                transform=libcamera.Transform(hflip=cfg.hflip, vflip=cfg.vflip),
+                buffer_count=cfg.buffer_count,
+            )
+            cam.configure(config)
+            # picamera2 may round the size; make_array's rows are cropped to this width.
+            self._width = int(cam.camera_configuration()["main"]["size"][0])
+            cam.start()
+        except (RuntimeError, ValueError, KeyError, TypeError) as exc:
+            self._cam = cam
+            self.close()
+            raise CameraError(f"camera {cfg.camera_num}: cannot configure and start: {exc}") from exc
+        self._cam = cam
+        self._boot_offset_ns = _boot_offset_ns()
+        self._prev_sensor_ns = None
+        self._next_index = 0
+        self._dropped = 0
+        self._timeouts = 0
+
+    def _acquire(self, picamera2_cls: Any) -> Any:
+        n = self._cfg.camera_num
+        attempts = self._cfg.retries + 1
+        delay = self._backoff_s
+        for attempt in range(1, attempts + 1):
+            try:
+                return picamera2_cls(n)
+            except IndexError:
+                error = CameraError(f"no camera {n} ({self._count_cameras(picamera2_cls)} found)")
+            except RuntimeError as exc:
+                error = CameraError(f"camera {n} busy or failing to open ({exc}); "
+                                    "is another process using it?")
+            if attempt < attempts:
+                _log.warning("%s; retrying in %.1f s (%d of %d)", error, delay, attempt, attempts)
+                self._sleep(delay)
+                delay = min(delay * 2.0, self._max_backoff_s)
+        raise error
+
+    @staticmethod
+    def _count_cameras(picamera2_cls: Any) -> str:
+        try:
+            return str(len(picamera2_cls.global_camera_info()))
+        except Exception:  # only for the message: never mask the real error
+            return "none"
+
+    def read(self) -> Optional[Frame]:
+        """The newest frame; FrameError on one timeout, CameraError after ``cfg.retries`` in a row."""
+        cam = self._cam
+        if cam is None:
+            raise SourceError("Picamera2 source is not open")
+        try:
+            request = cam.capture_request(wait=self._cfg.timeout_s)
+        except _TIMEOUTS:
+            raise self._timed_out(cam) from None
+        except (RuntimeError, concurrent.futures.CancelledError) as exc:
+            raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc}") from exc
+        received_ns = self._clock()
+        try:
+            array = request.make_array("main")
+            metadata = request.get_metadata()
+        except (RuntimeError, ValueError) as exc:
+            raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
+        finally:
+            request.release()
+        self._timeouts = 0
+        if isinstance(array, np.ndarray) and array.ndim == 3:
+            array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
+        image = validate_frame(array)
+        return self._stamp(image, metadata, received_ns)
+
+    def _timed_out(self, cam: Any) -> FrameError:
+        # The timed-out job is still queued: flush it before it swallows a frame.
+        cam.cancel_all_and_flush()
+        self._timeouts += 1
+        limit = max(1, self._cfg.retries)
+        msg = f"camera {self._cfg.camera_num}: no frame within {self._cfg.timeout_s:g} s"
+        if self._timeouts >= limit:
+            return CameraError(f"{msg} ({self._timeouts} times in a row); giving up")
+        return FrameError(f"{msg} (timeout {self._timeouts} of {limit})")
+
+    def _stamp(self, image: np.ndarray, metadata: Dict[str, Any], received_ns: int) -> Frame:
+        sensor_ns = metadata.get("SensorTimestamp")
+        if sensor_ns is None:
+            t_ns = received_ns
+        else:
+            sensor_ns = int(sensor_ns)
+            t_ns = sensor_to_monotonic_ns(sensor_ns, received_ns, self._boot_offset_ns)
+            duration_us = metadata.get("FrameDuration")
+            period_ns = duration_us * 1e3 if duration_us else 1e9 / self._cfg.fps
+            missed = frames_missed(self._prev_sensor_ns, sensor_ns, period_ns)
+            self._dropped += missed
+            self._next_index += missed
+            self._prev_sensor_ns = sensor_ns
+        index = self._next_index
+        self._next_index += 1
+        return Frame(image=image, t_mono_ns=t_ns, index=index, name=str(index))
+
+    def close(self) -> None:
+        """Flush, stop and close the camera, waiting at most ``stop_timeout_s``."""
+        cam, self._cam = self._cam, None
+        if cam is None:
+            return
+        done = threading.Event()
+
+        def shut_down() -> None:
+            # Each step runs even if the one before failed: the camera must be released.
+            for step in ("cancel_all_and_flush", "stop", "close"):
+                try:
+                    getattr(cam, step)()
+                except Exception as exc:  # log and go on releasing
+                    _log.warning("camera %d: %s() failed: %s", self._cfg.camera_num, step, exc)
+            done.set()
+
+        worker = threading.Thread(target=shut_down, name="picamera2-close", daemon=True)
+        worker.start()
+        if not done.wait(self._stop_timeout_s):
+            _log.error(
+                "camera %d did not stop within %.1f s; leaving it to the systemd watchdog",
+                self._cfg.camera_num, self._stop_timeout_s,
+            )

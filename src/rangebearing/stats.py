@@ -1,0 +1,67 @@
+"""Running statistics of the capture loop: rates, drops, per-stage time, latency."""
+
+from __future__ import annotations
+
+import collections
+from typing import Deque, Dict, Optional
+
+import numpy as np
+
+from ._compat import frozen
+
+
+@frozen
+class Summary:
+    """A snapshot of the loop's figures (times in milliseconds)."""
+
+    frames: int
+    bad_frames: int
+    dropped: int
+    fps: float
+    landmarks: int
+    latency_ms_p50: float
+    latency_ms_p99: float
+    stage_ms: Dict[str, float]
+
+    def line(self) -> str:
+        stages = " ".join(f"{k}={v:.2f}" for k, v in self.stage_ms.items())
+        return (
+            f"{self.frames} frames, {self.fps:.1f} fps, {self.landmarks} in view, "
+            f"dropped {self.dropped}, bad {self.bad_frames}, "
+            f"latency p50 {self.latency_ms_p50:.2f} ms p99 {self.latency_ms_p99:.2f} ms, stage ms {stages}"
+        )
+
+
+class LoopStats:
+    """Counts and timings; keeps the last ``window`` samples for percentiles."""
+
+    def __init__(self, window: int = 4096) -> None:
+        self.frames = 0
+        self.bad_frames = 0
+        self.landmarks = 0
+        self.latency_ns: Deque[int] = collections.deque(maxlen=window)
+        self.stage_ns: Dict[str, Deque[int]] = {}
+        self._window = window
+        self._rate_start_ns: Optional[int] = None
+        self._rate_frames = 0
+        self.fps = 0.0
+
+    def frame_done(self, now_ns: int, latency_ns: int, landmarks: int, stages_ns: Dict[str, int]) -> None:
+        self.frames += 1
+        self.landmarks = landmarks
+        self.latency_ns.append(latency_ns)
+        for name, ns in stages_ns.items():
+            self.stage_ns.setdefault(name, collections.deque(maxlen=self._window)).append(ns)
+        if self._rate_start_ns is None:
+            self._rate_start_ns = now_ns
+        self._rate_frames += 1
+        elapsed = now_ns - self._rate_start_ns
+        if elapsed >= 1_000_000_000:
+            self.fps = (self._rate_frames - 1) * 1e9 / elapsed if self._rate_frames > 1 else 0.0
+            self._rate_start_ns, self._rate_frames = now_ns, 1
+
+    def summary(self, dropped: int) -> Summary:
+        lat = np.asarray(self.latency_ns, dtype=np.float64) / 1e6
+        p50, p99 = (float(np.percentile(lat, 50)), float(np.percentile(lat, 99))) if lat.size else (0.0, 0.0)
+        stages = {k: float(np.median(v)) / 1e6 for k, v in self.stage_ns.items() if v}
+        return Summary(self.frames, self.bad_frames, dropped, self.fps, self.landmarks, p50, p99, stages)

@@ -1,0 +1,308 @@
+"""A faithful fake of picamera2 for tests: same calls, same quirks, no camera.
+
+Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
+
+* ``Picamera2(n)`` raises IndexError for a camera that is not there and
+  RuntimeError("Camera __init__ sequence did not complete.") for one that is
+  already open (busy).
+* ``capture_request()`` queues a job whose Future is completed by the next
+  frame. Without ``wait=`` it blocks forever; with ``wait=t`` it raises
+  ``concurrent.futures.TimeoutError`` and the job STAYS queued, so it eats the
+  next frame (and leaks its request) unless ``cancel_all_and_flush()`` is
+  called. ``stop()`` queues behind such a job and hangs.
+* ``"RGB888"`` arrays are [B, G, R] per pixel, ``"BGR888"`` [R, G, B],
+  ``"XBGR8888"`` [R, G, B, 255], ``"XRGB8888"`` [B, G, R, 255].
+* Requests are reference counted and hold one of ``buffer_count`` buffers;
+  when all are held, no frame can complete (the camera stalls).
+
+Frames are produced synchronously, one per pending job, from ``WORLD.producer``
+(RGB content). ``WORLD`` also stalls the sensor, skips frames (timestamp gaps),
+pads rows like old ``make_array`` did and makes ``stop()`` hang.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from concurrent.futures import CancelledError, Future, TimeoutError
+from typing import Any, Callable, Dict, List, Optional
+
+import libcamera
+import numpy as np
+
+__all__ = ["WORLD", "CancelledError", "CompletedRequest", "Picamera2", "TimeoutError", "shutdown"]
+
+_KNOWN_CONTROLS = {
+    "AeEnable", "ExposureTime", "AnalogueGain", "AwbEnable", "AwbMode", "ColourGains",
+    "FrameDurationLimits", "NoiseReductionMode", "Brightness", "Contrast", "Saturation",
+    "Sharpness", "ScalerCrop",
+}
+_BYTES_PER_PIXEL = {"RGB888": 3, "BGR888": 3, "XBGR8888": 4, "XRGB8888": 4}
+
+
+def _grey_producer(seq: int, height: int, width: int) -> np.ndarray:
+    return np.full((height, width, 3), seq % 256, dtype=np.uint8)
+
+
+class World:
+    """The fake camera hardware and the test's handles on it."""
+
+    def __init__(self) -> None:
+        self.lock = threading.RLock()
+        self.num_cameras = 1
+        self.producer: Callable[[int, int, int], np.ndarray] = _grey_producer
+        self.frame_period_ns: Optional[int] = None  # None: the configured FrameDurationLimits
+        self.sensor_clock_offset_ns = 0  # add e.g. suspend time to mimic CLOCK_BOOTTIME
+        self.padded_width_px = 0  # extra junk columns make_array returns (old picamera2)
+        self.stalled = False
+        self.hang_stop = False
+        self.release = threading.Event()  # set at teardown: un-hangs anything blocked
+        self.open_cameras: set = set()
+        self.instances: List[Picamera2] = []
+        self.capture_waits: List[Any] = []
+        self.outstanding: List[CompletedRequest] = []
+        self.skip_next = 0
+
+    def set_stalled(self, stalled: bool) -> None:
+        """Stall or resume the sensor; resuming completes jobs that are still queued."""
+        with self.lock:
+            self.stalled = stalled
+            for cam in self.instances:
+                cam._pump()
+
+    def skip(self, frames: int) -> None:
+        """Lose ``frames`` frames before the next one (a gap in SensorTimestamp)."""
+        with self.lock:
+            self.skip_next += frames
+
+
+WORLD = World()
+
+
+def shutdown() -> None:
+    """Test teardown: cancel queued jobs and un-hang any blocked stop()."""
+    WORLD.release.set()
+    with WORLD.lock:
+        for cam in WORLD.instances:
+            for job in cam._jobs:
+                job.cancel()
+
+
+class CompletedRequest:
+    """A frame's buffers and metadata; must be released exactly once."""
+
+    def __init__(self, picam2: Picamera2, image: np.ndarray, metadata: Dict[str, Any]) -> None:
+        self.picam2 = picam2
+        self.ref_count = 1
+        self._image: Optional[np.ndarray] = image
+        self._metadata = metadata
+        self.config = dict(picam2.camera_config)
+
+    def acquire(self) -> None:
+        with WORLD.lock:
+            if self.ref_count == 0:
+                raise RuntimeError("CompletedRequest: acquiring lock with ref_count 0")
+            self.ref_count += 1
+
+    def release(self) -> None:
+        with WORLD.lock:
+            self.ref_count -= 1
+            if self.ref_count < 0:
+                raise RuntimeError("CompletedRequest: lock now has negative ref_count")
+            if self.ref_count == 0:
+                self._image = None
+                if self in WORLD.outstanding:
+                    WORLD.outstanding.remove(self)
+                self.picam2._pump()
+
+    def make_array(self, name: str) -> np.ndarray:
+        if name != "main":
+            raise RuntimeError(f"Stream {name!r} is not defined")
+        if self._image is None:
+            raise RuntimeError("request already released")
+        return self._image.copy()
+
+    def get_metadata(self) -> Dict[str, Any]:
+        return dict(self._metadata)
+
+
+class _Job:
+    def __init__(self) -> None:
+        self.future: Future = Future()
+        self.future.set_running_or_notify_cancel()
+
+    def cancel(self) -> None:
+        if not self.future.done():
+            self.future.set_exception(CancelledError())
+
+
+class Picamera2:
+    """The fake camera: see the module docstring for the behaviour it copies."""
+
+    def __init__(self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None) -> None:
+        with WORLD.lock:
+            if not 0 <= camera_num < WORLD.num_cameras:
+                raise IndexError("list index out of range")  # global_camera_info()[camera_num]
+            if camera_num in WORLD.open_cameras:
+                raise RuntimeError("Camera __init__ sequence did not complete.")
+            WORLD.open_cameras.add(camera_num)
+            WORLD.instances.append(self)
+        self.camera_idx = camera_num
+        self.is_open = True
+        self.started = False
+        self.camera_config: Optional[Dict[str, Any]] = None
+        self._jobs: List[_Job] = []
+        self._seq = 0
+        self._t0_ns = 0
+        self.stop_calls = 0
+
+    @staticmethod
+    def global_camera_info() -> List[Dict[str, Any]]:
+        return [{"Model": "imx219", "Id": f"/base/fake/imx219@{i}", "Num": i}
+                for i in range(WORLD.num_cameras)]
+
+    def __enter__(self) -> Picamera2:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def create_video_configuration(self, main: Optional[Dict[str, Any]] = None, lores: Any = None,
+                                   raw: Any = None, transform: Any = None, colour_space: Any = None,
+                                   buffer_count: int = 6, controls: Optional[Dict[str, Any]] = None,
+                                   display: Optional[str] = "main", encode: Optional[str] = "main",
+                                   queue: bool = True, sensor: Any = None,
+                                   use_case: str = "video") -> Dict[str, Any]:
+        if not self.is_open:
+            raise RuntimeError("Camera not opened")
+        stream = {"format": "XBGR8888", "size": (1280, 720), "preserve_ar": True}
+        for key, value in (main or {}).items():
+            if key not in ("format", "size", "stride", "preserve_ar"):
+                raise ValueError(f"Bad key {key!r}: valid stream configuration keys are "
+                                 "('format', 'size', 'stride', 'preserve_ar')")
+            stream[key] = value
+        w, h = stream["size"]
+        stream["size"] = (w - w % 2, h - h % 2)  # align_stream(optimal=False)
+        merged = {"NoiseReductionMode": 1, "FrameDurationLimits": (33333, 33333)}
+        merged.update(controls or {})
+        return {"use_case": use_case, "transform": transform or libcamera.Transform(),
+                "colour_space": colour_space, "buffer_count": buffer_count, "queue": queue,
+                "main": stream, "lores": lores, "raw": raw, "controls": merged,
+                "sensor": sensor, "display": display, "encode": encode}
+
+    def configure(self, camera_config: Dict[str, Any]) -> None:
+        if self.started:
+            raise RuntimeError("Camera must be stopped before configuring")
+        config = dict(camera_config)
+        main = dict(config["main"])
+        if main["format"] not in _BYTES_PER_PIXEL:
+            raise RuntimeError(f"Bad format {main['format']} in stream main")
+        if not isinstance(config["transform"], libcamera.Transform):
+            raise RuntimeError("Transform has incorrect type")
+        controls = dict(config["controls"])
+        if "FrameRate" in controls:  # picamera2's virtual control for FrameDurationLimits
+            rate = controls.pop("FrameRate")
+            controls["FrameDurationLimits"] = (int(1e6 / rate), int(1e6 / rate))
+        for name in controls:
+            if name not in _KNOWN_CONTROLS:
+                raise RuntimeError(f"Control {name} is not advertised by libcamera")
+        config["controls"] = controls
+        main["stride"] = main["size"][0] * _BYTES_PER_PIXEL[main["format"]]
+        config["main"] = main
+        self.camera_config = config
+
+    def camera_configuration(self) -> Optional[Dict[str, Any]]:
+        return self.camera_config
+
+    def start(self, config: Any = None, show_preview: Any = False) -> None:
+        if config is not None:
+            self.configure(config)
+        if self.camera_config is None:
+            raise RuntimeError("Camera has not been configured")
+        self.started = True
+        # Sensor time starts in the past so stamps stay behind time.monotonic_ns().
+        self._t0_ns = time.monotonic_ns() - 5_000_000_000
+
+    def capture_request(self, wait: Any = None, signal_function: Any = None, flush: Any = None) -> Any:
+        job = _Job()
+        with WORLD.lock:
+            WORLD.capture_waits.append(wait)
+            self._jobs.append(job)
+            self._pump()
+        if wait is False:
+            return job
+        timeout = None if wait is None or wait is True else float(wait)
+        return job.future.result(timeout=timeout)  # None: blocks until a frame or a cancel
+
+    def cancel_all_and_flush(self) -> None:
+        with WORLD.lock:
+            for job in self._jobs:
+                job.cancel()
+            self._jobs = []
+
+    def stop(self) -> None:
+        self.stop_calls += 1
+        if not self.started:
+            return
+        with WORLD.lock:
+            blocked = bool(self._jobs) or WORLD.hang_stop
+        if blocked:  # the stop job queues behind stale jobs that never complete
+            WORLD.release.wait()
+        self.started = False
+
+    def close(self) -> None:
+        if not self.is_open:
+            return
+        self.stop()
+        with WORLD.lock:
+            self.is_open = False
+            WORLD.open_cameras.discard(self.camera_idx)
+
+    def _buffers_free(self) -> bool:
+        held = sum(1 for r in WORLD.outstanding if r.picam2 is self)
+        return held < self.camera_config["buffer_count"]
+
+    def _pump(self) -> None:
+        """Complete queued jobs, oldest first, one new frame each (caller holds WORLD.lock)."""
+        while self._jobs and self.started and not WORLD.stalled and self._buffers_free():
+            job = self._jobs.pop(0)
+            request = self._next_request()
+            WORLD.outstanding.append(request)
+            job.future.set_result(request)
+
+    def _next_request(self) -> CompletedRequest:
+        self._seq += 1 + WORLD.skip_next
+        WORLD.skip_next = 0
+        main = self.camera_config["main"]
+        w, h = main["size"]
+        rgb = np.asarray(WORLD.producer(self._seq, h, w), dtype=np.uint8)
+        transform = self.camera_config["transform"]
+        if transform.hflip:
+            rgb = rgb[:, ::-1]
+        if transform.vflip:
+            rgb = rgb[::-1]
+        image = _to_format(rgb, main["format"])
+        if WORLD.padded_width_px:
+            pad = np.full((h, WORLD.padded_width_px, image.shape[2]), 77, dtype=np.uint8)
+            image = np.concatenate([image, pad], axis=1)
+        duration_us = int(self.camera_config["controls"]["FrameDurationLimits"][0])
+        period_ns = WORLD.frame_period_ns or duration_us * 1000
+        metadata = {
+            "SensorTimestamp": self._t0_ns + self._seq * period_ns + WORLD.sensor_clock_offset_ns,
+            "FrameDuration": period_ns // 1000,
+            "ExposureTime": min(10000, duration_us),
+            "AnalogueGain": 1.0,
+        }
+        return CompletedRequest(self, np.ascontiguousarray(image), metadata)
+
+
+def _to_format(rgb: np.ndarray, fmt: str) -> np.ndarray:
+    """RGB content in the byte order picamera2's make_array returns for ``fmt``."""
+    if fmt == "RGB888":
+        return rgb[:, :, ::-1]  # [B, G, R]
+    if fmt == "BGR888":
+        return rgb
+    alpha = np.full(rgb.shape[:2] + (1,), 255, dtype=np.uint8)
+    if fmt == "XBGR8888":
+        return np.concatenate([rgb, alpha], axis=2)  # [R, G, B, 255]
+    return np.concatenate([rgb[:, :, ::-1], alpha], axis=2)  # XRGB8888: [B, G, R, 255]

@@ -1,0 +1,99 @@
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rangebearing.config import Config, config_from_mapping, dump_config, load_config
+from rangebearing.errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_defaults_without_a_file():
+    cfg = load_config(None)
+    assert cfg == Config()
+    assert cfg.detection.median_ksize == 15
+    assert cfg.publish.unicast == (("127.0.0.1", 47800),)
+    assert cfg.publish.multicast_group == ""  # multicast is opt-in
+
+
+def test_shipped_config_files_load():
+    for path in sorted((ROOT / "config").glob("*.yaml")):
+        load_config(path)
+
+
+def test_dump_round_trips():
+    cfg = load_config(ROOT / "config" / "rangebearing.yaml")
+    again = load_config_text(dump_config(cfg))
+    assert dataclass_equal(again, cfg)
+
+
+def load_config_text(text):
+    import yaml
+
+    return config_from_mapping(yaml.safe_load(text))
+
+
+def dataclass_equal(a, b):
+    return {k: getattr(a, k) for k in ("camera", "landmark", "detection", "model", "source", "publish", "daemon")} == {
+        k: getattr(b, k) for k in ("camera", "landmark", "detection", "model", "source", "publish", "daemon")
+    }
+
+
+def test_every_problem_is_named_at_once(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "camera: {fx_px: -3, colour: red}\n"
+        "detection: {median_ksize: 14, method: magic}\n"
+        "publish: {unicast: [nohostport], multicast_group: 10.0.0.1}\n"
+        "extra: 1\n"
+    )
+    with pytest.raises(ConfigError) as err:
+        load_config(bad)
+    msg = str(err.value)
+    assert str(bad) in msg
+    for key in ("camera.fx_px", "camera.colour", "detection.median_ksize", "detection.method", "publish.unicast",
+                "publish.multicast_group", "'extra'"):
+        assert key in msg, key
+    assert len(err.value.problems) == 7
+    assert isinstance(err.value, ValueError)
+
+
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("camera: [1, 2]\n", "camera: must be a mapping"),
+        ("- just\n- a list\n", "top level must be a mapping"),
+        ("camera: {fx_px: 1\n", "not valid YAML"),
+        ("detection: {red_hue: [[0, 200]]}\n", "detection.red_hue"),
+        ("model: {envelope_range_m: [2.0, 0.1]}\n", "model.envelope_range_m"),
+        ("landmark: {band_height_m: 0.04}\n", "two bands do not fit"),
+        ("detection: {tracking: 'yes'}\n", "expected true or false"),
+        ("source: {controls: {aeenable: 1}}\n", "source.controls"),
+    ],
+)
+def test_specific_problems(tmp_path, text, fragment):
+    f = tmp_path / "c.yaml"
+    f.write_text(text)
+    with pytest.raises(ConfigError, match=None) as err:
+        load_config(f)
+    assert fragment in str(err.value)
+
+
+def test_missing_file_is_a_config_error(tmp_path):
+    with pytest.raises(ConfigError, match="cannot read file"):
+        load_config(tmp_path / "nope.yaml")
+
+
+def test_cli_reports_bad_config_without_traceback(tmp_path):
+    f = tmp_path / "c.yaml"
+    f.write_text("camera: {fx_px: -3}\ndetection: {downscale: 9}\n")
+    proc = subprocess.run(
+        [sys.executable, "-m", "rangebearing.cli.main", "run", "--config", str(f), "--check"],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("rangebearing: error:")
+    assert "camera.fx_px" in proc.stderr and "detection.downscale" in proc.stderr
+    assert "Traceback" not in proc.stderr
