@@ -53,8 +53,15 @@ def test_every_problem_is_named_at_once(tmp_path):
         load_config(bad)
     msg = str(err.value)
     assert str(bad) in msg
-    for key in ("camera.fx_px", "camera.colour", "detection.median_ksize", "detection.method", "publish.unicast",
-                "publish.multicast_group", "'extra'"):
+    for key in (
+        "camera.fx_px",
+        "camera.colour",
+        "detection.median_ksize",
+        "detection.method",
+        "publish.unicast",
+        "publish.multicast_group",
+        "'extra'",
+    ):
         assert key in msg, key
     assert len(err.value.problems) == 7
     assert isinstance(err.value, ValueError)
@@ -91,7 +98,9 @@ def test_cli_reports_bad_config_without_traceback(tmp_path):
     f.write_text("camera: {fx_px: -3}\ndetection: {downscale: 9}\n")
     proc = subprocess.run(
         [sys.executable, "-m", "rangebearing.cli.main", "run", "--config", str(f), "--check"],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert proc.returncode == 2
     assert proc.stderr.startswith("rangebearing: error:")

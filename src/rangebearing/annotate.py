@@ -23,8 +23,9 @@ def annotate(frame_bgr: np.ndarray, result: FrameResult) -> np.ndarray:
         colour = GREEN if lm.in_envelope else GREY
         cv2.rectangle(out, (x, y), (x + w, y + h), colour, 1)
         for (cx, cy), c in ((lm.red_xy_px, RED), (lm.blue_xy_px, BLUE)):
-            cv2.drawMarker(out, (int(round(cx)), int(round(cy))), c, cv2.MARKER_CROSS, 9, 1)
-        cv2.line(out, tuple(int(round(v)) for v in lm.red_xy_px), tuple(int(round(v)) for v in lm.blue_xy_px), colour, 1)
+            cv2.drawMarker(out, (round(cx), round(cy)), c, cv2.MARKER_CROSS, 9, 1)
+        (rx, ry), (bx, by) = lm.red_xy_px, lm.blue_xy_px
+        cv2.line(out, (round(rx), round(ry)), (round(bx), round(by)), colour, 1)
         label = f"{lm.range_m:.3f} m {math.degrees(lm.bearing_rad):+.1f} deg"
         ty = y - 4 if y > 12 else y + h + 12
         cv2.putText(out, label, (x, ty), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 3, cv2.LINE_AA)

@@ -231,40 +231,85 @@ def _controls(v: Any) -> Tuple[Tuple[str, Any], ...]:
 
 
 SCHEMA: Dict[str, Tuple[type, Dict[str, Check]]] = {
-    "camera": (CameraIntrinsics, {
-        "width_px": _positive(True), "height_px": _positive(True),
-        "fx_px": _positive(), "fy_px": _positive(),
-        "cx_px": _number(0, 10000), "cy_px": _number(0, 10000),
-        "distortion": _distortion,
-    }),
-    "landmark": (LandmarkGeometry, {
-        "height_m": _positive(), "diameter_m": _positive(), "band_height_m": _positive(),
-    }),
-    "detection": (DetectionConfig, {
-        "method": _choice(*METHODS), "median_ksize": _odd_ksize,
-        "downscale": _number(1, 4, integer=True), "white_balance": _choice(*WHITE_BALANCE),
-        "red_hue": _hue_ranges, "blue_hue": _hue_ranges,
-        "s_min": _number(0, 255, integer=True), "v_min": _number(0, 255, integer=True),
-        "min_band_px": _number(1, 100), "max_landmarks": _positive(True),
-        "tracking": _bool, "full_scan_every": _positive(True),
-    }),
-    "model": (ModelConfig, {
-        "kind": _choice(*MODELS), "k_px_m": _positive(), "c_m": _number(-0.5, 0.5),
-        "kh_m_per_px": _positive(), "cylinder_correction": _bool,
-        "envelope_range_m": _pair(0, 100), "envelope_bearing_rad": _pair(-math.pi, math.pi),
-    }),
-    "source": (SourceConfig, {
-        "kind": _choice(*SOURCES), "path": _string, "fps": _positive(), "loop": _bool,
-        "device": _string, "camera_num": _number(0, 16, integer=True),
-        "width_px": _positive(True), "height_px": _positive(True),
-        "hflip": _bool, "vflip": _bool, "buffer_count": _number(1, 16, integer=True),
-        "timeout_s": _positive(), "retries": _number(0, 1000, integer=True), "controls": _controls,
-    }),
-    "publish": (PublishConfig, {
-        "robot_id": _string, "unicast": _destinations, "multicast_group": _string,
-        "multicast_port": _number(1, 65535, integer=True),
-        "multicast_ttl": _number(0, 255, integer=True), "multicast_interface": _string,
-    }),
+    "camera": (
+        CameraIntrinsics,
+        {
+            "width_px": _positive(True),
+            "height_px": _positive(True),
+            "fx_px": _positive(),
+            "fy_px": _positive(),
+            "cx_px": _number(0, 10000),
+            "cy_px": _number(0, 10000),
+            "distortion": _distortion,
+        },
+    ),
+    "landmark": (
+        LandmarkGeometry,
+        {
+            "height_m": _positive(),
+            "diameter_m": _positive(),
+            "band_height_m": _positive(),
+        },
+    ),
+    "detection": (
+        DetectionConfig,
+        {
+            "method": _choice(*METHODS),
+            "median_ksize": _odd_ksize,
+            "downscale": _number(1, 4, integer=True),
+            "white_balance": _choice(*WHITE_BALANCE),
+            "red_hue": _hue_ranges,
+            "blue_hue": _hue_ranges,
+            "s_min": _number(0, 255, integer=True),
+            "v_min": _number(0, 255, integer=True),
+            "min_band_px": _number(1, 100),
+            "max_landmarks": _positive(True),
+            "tracking": _bool,
+            "full_scan_every": _positive(True),
+        },
+    ),
+    "model": (
+        ModelConfig,
+        {
+            "kind": _choice(*MODELS),
+            "k_px_m": _positive(),
+            "c_m": _number(-0.5, 0.5),
+            "kh_m_per_px": _positive(),
+            "cylinder_correction": _bool,
+            "envelope_range_m": _pair(0, 100),
+            "envelope_bearing_rad": _pair(-math.pi, math.pi),
+        },
+    ),
+    "source": (
+        SourceConfig,
+        {
+            "kind": _choice(*SOURCES),
+            "path": _string,
+            "fps": _positive(),
+            "loop": _bool,
+            "device": _string,
+            "camera_num": _number(0, 16, integer=True),
+            "width_px": _positive(True),
+            "height_px": _positive(True),
+            "hflip": _bool,
+            "vflip": _bool,
+            "buffer_count": _number(1, 16, integer=True),
+            "timeout_s": _positive(),
+            "retries": _number(0, 1000, integer=True),
+            "controls": _controls,
+        },
+    ),
+    "publish": (
+        PublishConfig,
+        {
+            "robot_id": _string,
+            "unicast": _destinations,
+            "multicast_group": _string,
+            "multicast_port": _number(1, 65535, integer=True),
+            "multicast_ttl": _number(0, 255, integer=True),
+            "multicast_interface": _string,
+        },
+    ),
     "daemon": (DaemonConfig, {"status_interval_s": _positive(), "echo": _bool}),
 }
 

@@ -152,7 +152,9 @@ class Daemon:
             t2 = clock()
             seq += 1
             self.stats.frame_done(
-                t2, t2 - frame.t_mono_ns, len(result.landmarks),
+                t2,
+                t2 - frame.t_mono_ns,
+                len(result.landmarks),
                 {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1},
             )
             if self.echo:

@@ -76,7 +76,9 @@ class AccuracyReport:
         return self.detected / self.truths if self.truths else 1.0
 
 
-def accuracy(frames: Iterable[Tuple[str, Sequence[Landmark], Sequence[TruthRow]]]) -> Tuple[AccuracyReport, List[Match]]:
+def accuracy(
+    frames: Iterable[Tuple[str, Sequence[Landmark], Sequence[TruthRow]]],
+) -> Tuple[AccuracyReport, List[Match]]:
     """Evaluate ``(frame, detections, truths)`` triples; returns the report and every match."""
     matches: List[Match] = []
     n_frames = n_false = 0

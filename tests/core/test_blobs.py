@@ -38,7 +38,7 @@ def test_weighted_centroid_sub_pixel_from_partial_weights():
     w[2, 1] = 1.0
     w[2, 2] = 1.0
     w[2, 3] = 0.5  # half-covered edge pixel pulls the centroid right
-    x, y, m = weighted_centroid(w)
+    x, y, _ = weighted_centroid(w)
     assert x == pytest.approx((1 + 2 + 1.5) / 2.5)
     assert y == pytest.approx(2.0)
     assert weighted_centroid(np.zeros((3, 3), np.float32)) is None

@@ -56,8 +56,16 @@ def test_range_falls_as_L_grows(L1, L2, dx):
     if abs(L1 - L2) < 1e-6:
         return
     for model in (PIN, PAPER):
-        r1 = (pinhole_reading(*centroids(dx, L1), CAM, model, GEO) if model is PIN else paper_reading(*centroids(dx, L1), CAM, model))[0]
-        r2 = (pinhole_reading(*centroids(dx, L2), CAM, model, GEO) if model is PIN else paper_reading(*centroids(dx, L2), CAM, model))[0]
+        r1 = (
+            pinhole_reading(*centroids(dx, L1), CAM, model, GEO)
+            if model is PIN
+            else paper_reading(*centroids(dx, L1), CAM, model)
+        )[0]
+        r2 = (
+            pinhole_reading(*centroids(dx, L2), CAM, model, GEO)
+            if model is PIN
+            else paper_reading(*centroids(dx, L2), CAM, model)
+        )[0]
         assert (r1 > r2) == (L1 < L2)
 
 
@@ -65,7 +73,7 @@ def test_paper_model_by_hand():
     # L = 100 px → d_v = 3500/100 cm = 0.35 m; 50 px left → d_h = 0.0395 m
     r, b = centroids(-50, 100)
     rng, th, d_v, d_h, L = paper_reading(r, b, CAM, PAPER)
-    assert L == pytest.approx(100)
+    assert pytest.approx(100) == L
     assert d_v == pytest.approx(0.35)
     assert d_h == pytest.approx(0.0395)
     assert th == pytest.approx(math.atan(0.0395 / 0.35))
@@ -75,7 +83,7 @@ def test_paper_model_by_hand():
 def test_pinhole_model_by_hand():
     # on the axis: range = k/L + c
     r, b = centroids(0, 100)
-    rng, th, d_v, d_h, L = pinhole_reading(r, b, CAM, PIN, GEO)
+    rng, _th, d_v, d_h, _L = pinhole_reading(r, b, CAM, PIN, GEO)
     assert rng == pytest.approx(PIN.k_px_m / 100 + PIN.c_m)
     assert d_h == pytest.approx(0.0) and d_v == pytest.approx(rng)
 
@@ -93,7 +101,9 @@ def test_normalised_undoes_distortion():
     cam = dataclasses.replace(CAM, distortion=(-0.2, 0.05, 0.0, 0.0, 0.0))
     k = np.array([[cam.fx_px, 0, cam.cx_px], [0, cam.fy_px, cam.cy_px], [0, 0, 1.0]])
     ideal = np.array([[0.3, -0.2], [-0.35, 0.1], [0.0, 0.0]])
-    pts, _ = cv2.projectPoints(np.column_stack((ideal, np.ones(3))), np.zeros(3), np.zeros(3), k, np.array(cam.distortion))
+    pts, _ = cv2.projectPoints(
+        np.column_stack((ideal, np.ones(3))), np.zeros(3), np.zeros(3), k, np.array(cam.distortion)
+    )
     assert normalised(pts.reshape(-1, 2), cam) == pytest.approx(ideal, abs=1e-6)
 
 

@@ -3,23 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import math
 import sys
 from pathlib import Path
-from typing import Any, List
+from typing import Any
 
+from ..calibration import calibrate
 from ..config import dump_config
-from ..core.calibrate import Fit, Sample, fit_model
-from ..core.pipeline import Pipeline
+from ..core.calibrate import Fit
 from ..errors import CalibrationError, RangeBearingError
-from ..evaluate import match_frame
 from ..sources.recorded import count_recorded, iter_recorded
 from ..truth import read_truth
 from .common import add_config_arg, config_from_args, progress
-
-# Before calibration the model may be far off; match detections to truth loosely.
-CALIBRATION_GAP_RAD = math.radians(10.0)
 
 
 def register(sub: Any) -> None:
@@ -35,25 +30,6 @@ def register(sub: Any) -> None:
     add_config_arg(p)
     p.add_argument("--plot", metavar="FILE.png", help="plot measured against true range and the residuals")
     p.set_defaults(func=run)
-
-
-def collect_samples(path: Path, truth: dict, pipe: Pipeline) -> List[Sample]:
-    """Detect landmarks in every frame and pair them with their truth."""
-    cam = pipe.cfg.camera
-    samples = []
-    for name, image in progress(iter_recorded(path), count_recorded(path), "calibrate"):
-        rows = truth.get(name, [])
-        if image is None or not rows:
-            continue
-        found = pipe.process(image).landmarks
-        matches, _ = match_frame(name, found, rows, CALIBRATION_GAP_RAD)
-        for m in matches:
-            if m.found is None:
-                continue
-            lm = m.found
-            px_left = cam.cx_px - 0.5 * (lm.red_xy_px[0] + lm.blue_xy_px[0])
-            samples.append(Sample(name, lm.l_px, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad))
-    return samples
 
 
 def print_fit(fit: Fit) -> None:
@@ -100,13 +76,14 @@ def plot_fit(fit: Fit, path: str) -> None:
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     truth = read_truth(args.truth)
-    samples = collect_samples(Path(args.path), truth, Pipeline(cfg, track=False))
-    fit = fit_model(samples, cfg.model)
+    path = Path(args.path)
+    frames = ((name, image, truth.get(name, [])) for name, image in iter_recorded(path))
+    new_cfg, fit = calibrate(progress(frames, count_recorded(path), "calibrate"), cfg)
     print_fit(fit)
     out = Path(args.out)
     header = f"# rangebearing config written by 'rangebearing calibrate' from {args.path}\n"
     try:
-        out.write_text(header + dump_config(dataclasses.replace(cfg, model=fit.model)), encoding="utf-8")
+        out.write_text(header + dump_config(new_cfg), encoding="utf-8")
     except OSError as exc:
         raise CalibrationError(f"cannot write {out}: {exc.strerror or exc}") from None
     print(f"wrote {out}", file=sys.stderr)

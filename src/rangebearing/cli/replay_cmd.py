@@ -76,7 +76,11 @@ def run(args: argparse.Namespace) -> int:
                 continue
             key: Union[str, int] = int(name) if is_video else name
             if out:
-                rec = {"frame": key, "landmarks": [landmark_json(lm) for lm in result.landmarks], "tracked": result.tracked}
+                rec = {
+                    "frame": key,
+                    "landmarks": [landmark_json(lm) for lm in result.landmarks],
+                    "tracked": result.tracked,
+                }
                 out.write(json.dumps(rec, separators=(",", ":")) + "\n")
             if not args.quiet:
                 print(f"{name}: " + ("  |  ".join(describe(lm) for lm in result.landmarks) or "-"), flush=True)

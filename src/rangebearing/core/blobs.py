@@ -57,8 +57,8 @@ def find_blobs(
                 bbox_px=(
                     int(ox + x * scale),
                     int(oy + y * scale),
-                    int(round(w * scale)),
-                    int(round(h * scale)),
+                    round(w * scale),
+                    round(h * scale),
                 ),
             )
         )

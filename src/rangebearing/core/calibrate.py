@@ -108,7 +108,9 @@ def fit_model(samples: Sequence[Sample], base: ModelConfig) -> Fit:
         (k, c), *_ = np.linalg.lstsq(a, rng, rcond=None)
         if k <= 0:
             raise CalibrationError("fitted k is not positive: the measured band spacing does not shrink with range")
-        model = dataclasses.replace(base, k_px_m=float(k), c_m=float(c), envelope_range_m=env_r, envelope_bearing_rad=env_b)
+        model = dataclasses.replace(
+            base, k_px_m=float(k), c_m=float(c), envelope_range_m=env_r, envelope_bearing_rad=env_b
+        )
         f_rng = k * x + c
         f_th = th_m
     residuals = tuple(

@@ -15,6 +15,7 @@ Gains = Tuple[float, float, float]
 HueRanges = Sequence[Tuple[int, int]]
 
 UNIT_GAINS: Gains = (1.0, 1.0, 1.0)
+CHROMA_FLOOR = 0.15  # share of a band's chroma below which a pixel does not count
 
 
 def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
@@ -64,17 +65,36 @@ def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> 
     return mask
 
 
-def soft_weights(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int, ramp: int = 40) -> np.ndarray:
-    """Per-pixel band membership in [0, 1] (float32) for sub-pixel moments.
+def soft_weights(
+    hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int, ramp: int = 40
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Per-pixel band membership in [0, 1] for sub-pixel moments: ``(w_x, w_y)``, float32.
 
-    Pixels of the right hue weigh by saturation on a linear ramp from
-    ``s_min - ramp`` (0) to ``s_min + ramp`` (1), so a pixel half covered by
-    the band counts about half. Saturation, unlike chroma, does not depend on
-    brightness, so shading across the cylinder does not pull the centroid.
+    Both are zero outside the hue ranges.
+
+    ``w_x`` weighs by saturation on a linear ramp from ``s_min - ramp`` (0) to
+    ``s_min + ramp`` (1). Saturation does not depend on brightness, so the
+    shading across the cylinder does not pull the *horizontal* centroid.
+
+    ``w_y`` weighs by chroma (max − min channel, i.e. S·V) relative to the
+    band's own chroma (its 80th percentile), above a floor. Chroma is linear in the share of
+    a pixel the band covers whether the neighbour is the white body or the
+    dark robot below, so the *vertical* centroid, and with it L, is unbiased;
+    saturation would count a blue/black edge pixel as fully blue.
     """
     loose_s = max(0, s_min - ramp)
-    hue_ok = hue_mask(hsv, hue_ranges, loose_s, v_min)
+    hue_ok = hue_mask(hsv, hue_ranges, 1, 1) > 0
     s = hsv[:, :, 1].astype(np.float32)
-    w = np.clip((s - loose_s) * (1.0 / (2 * ramp)), 0.0, 1.0)
-    w[hue_ok == 0] = 0.0
-    return w
+    w_x = np.clip((s - loose_s) * (1.0 / (2 * ramp)), 0.0, 1.0)
+    w_x[~hue_ok | (hsv[:, :, 2] < v_min)] = 0.0
+    chroma = s * hsv[:, :, 2]
+    core = chroma[hue_ok & (s >= s_min)]
+    ref = float(np.percentile(core, 80)) if core.size else 0.0
+    if ref <= 0.0:
+        return w_x, w_x
+    # An affine ramp with a floor: faint blends count the same on either side of
+    # the band, and the chroma noise of neutral pixels counts not at all.
+    floor = CHROMA_FLOOR * ref
+    w_y = np.clip((chroma - floor) * (1.0 / (ref - floor)), 0.0, 1.0)
+    w_y[~hue_ok] = 0.0
+    return w_x, w_y

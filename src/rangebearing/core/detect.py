@@ -90,10 +90,11 @@ def refine_pair(bgr: np.ndarray, pair: BandPair, cfg: DetectionConfig, gains: Ga
         bx, by, bw_, bh_ = blob.bbox_px
         ax0, ay0 = max(bx - margin, rx0) - rx0, max(by - margin, ry0) - ry0
         ax1, ay1 = min(bx + bw_ + margin, rx1) - rx0, min(by + bh_ + margin, ry1) - ry0
-        c = weighted_centroid(soft_weights(hsv[ay0:ay1, ax0:ax1], hues, cfg.s_min, cfg.v_min))
-        if c is None:
+        w_x, w_y = soft_weights(hsv[ay0:ay1, ax0:ax1], hues, cfg.s_min, cfg.v_min)
+        cx, cy = weighted_centroid(w_x), weighted_centroid(w_y)
+        if cx is None or cy is None:
             return None
-        out.append((rx0 + ax0 + c[0], ry0 + ay0 + c[1]))
+        out.append((rx0 + ax0 + cx[0], ry0 + ay0 + cy[1]))
     width = 0.5 * (pair.red.width_px + pair.blue.width_px)
     return BandCentroids(red_xy_px=out[0], blue_xy_px=out[1], width_px=width, bbox_px=pair.bbox_px)
 

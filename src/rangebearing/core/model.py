@@ -78,7 +78,9 @@ def pinhole_reading(
     return rng, bearing, rng * math.cos(bearing), rng * math.sin(bearing), l_px
 
 
-def paper_reading(red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig) -> Tuple[float, float, float, float, float]:
+def paper_reading(
+    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig
+) -> Tuple[float, float, float, float, float]:
     """``(range_m, bearing_rad, d_v_m, d_h_m, l_px)`` with the paper's equations 1–4 as published."""
     l_px = math.hypot(blue_xy[0] - red_xy[0], blue_xy[1] - red_xy[1])
     d_v = model.k_px_m / l_px

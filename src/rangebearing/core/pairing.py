@@ -29,6 +29,9 @@ class PairingLimits:
     slack_px: float = 2.0  # absolute slack for small, quantised blobs
 
 
+DEFAULT_LIMITS = PairingLimits()
+
+
 def pair_score(red: Blob, blue: Blob, geometry: LandmarkGeometry, lim: PairingLimits) -> float:
     """How badly ``red`` over ``blue`` deviates from a landmark; ``inf`` if it cannot be one."""
     w = max(red.width_px, blue.width_px, 1)
@@ -57,7 +60,7 @@ def pair_bands(
     reds: Sequence[Blob],
     blues: Sequence[Blob],
     geometry: LandmarkGeometry,
-    limits: PairingLimits = PairingLimits(),
+    limits: PairingLimits = DEFAULT_LIMITS,
     max_pairs: int = 16,
 ) -> List[BandPair]:
     """Greedy best-first pairing: each blob joins at most one landmark.

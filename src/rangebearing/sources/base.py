@@ -8,7 +8,8 @@ source plays the part of gpiozero's mock pin backend.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Optional, Protocol, runtime_checkable
+import time
+from typing import TYPE_CHECKING, Callable, Optional, Protocol, runtime_checkable
 
 import cv2
 import numpy as np
@@ -105,13 +106,20 @@ def validate_frame(image: object) -> np.ndarray:
     return np.ascontiguousarray(image)
 
 
-def open_source(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
+Sleep = Callable[[float], object]
+
+
+def open_source(
+    cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep = time.sleep
+) -> FrameSource:
     """Build the source ``cfg.kind`` names, open it and return it.
 
     ``camera`` sizes the synthetic renderer; the other sources take their size
     from ``cfg``. Opening an already open source is a no-op, so a caller that
     calls ``open()`` again is harmless. The caller owns the source and must
-    ``close()`` it.
+    ``close()`` it. ``sleep`` paces recorded and synthetic frames and spaces
+    camera retries; pass ``threading.Event.wait`` so that setting the event
+    cuts any wait short (a sleep that returns True ends the wait).
 
     Raises
     ------
@@ -123,7 +131,7 @@ def open_source(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
     if cfg.kind == "recorded":
         from .recorded import RecordedSource
 
-        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop)
+        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep)
     elif cfg.kind == "opencv":
         from .opencv_capture import OpenCVSource
 
@@ -134,16 +142,16 @@ def open_source(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
     elif cfg.kind == "picamera2":
         from .picamera2_source import Picamera2Source
 
-        source = Picamera2Source(cfg)
+        source = Picamera2Source(cfg, sleep=sleep)
     elif cfg.kind == "synthetic":
-        source = _synthetic(cfg, camera)
+        source = _synthetic(cfg, camera, sleep)
     else:
         raise SourceError(f"unknown source kind {cfg.kind!r}")
     source.open()
     return source
 
 
-def _synthetic(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
+def _synthetic(cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep) -> FrameSource:
     try:
         from .synthetic import SyntheticSource
     except ImportError:
@@ -151,4 +159,4 @@ def _synthetic(cfg: SourceConfig, camera: CameraIntrinsics) -> FrameSource:
             "source kind 'synthetic' is not available yet (rangebearing.synth is missing); "
             "use 'recorded' with rendered frames instead"
         ) from None
-    return SyntheticSource(cfg, camera)
+    return SyntheticSource(cfg, camera, sleep=sleep)

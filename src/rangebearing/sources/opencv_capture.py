@@ -81,25 +81,32 @@ class OpenCVSource:
             # Requests only: a camera may pick the nearest mode it supports.
             cap.set(cv2.CAP_PROP_FRAME_WIDTH, self._width)
             cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self._height)
-            cap.set(cv2.CAP_PROP_FPS, self._fps)
-        self._stop.clear()
+            if self._fps > 0:
+                cap.set(cv2.CAP_PROP_FPS, self._fps)
+        # A fresh stop event per grabber: one left blocked by an earlier close()
+        # must never be revived by this open().
+        self._stop = threading.Event()
         self._ended = False
         self._failure = None
         self._thread = threading.Thread(
-            target=self._grab_loop, args=(cap,), name=f"opencv-grab-{self._device}", daemon=True
+            target=self._grab_loop, args=(cap, self._stop),
+            name=f"opencv-grab-{self._device}", daemon=True,
         )
         self._thread.start()
 
-    def _grab_loop(self, cap: cv2.VideoCapture) -> None:
+    def _grab_loop(self, cap: cv2.VideoCapture, stop: threading.Event) -> None:
         index = 0
         try:
-            while not self._stop.is_set():
+            while not stop.is_set():
                 try:
                     ok, image = cap.read()
                 except cv2.error as exc:
-                    self._finish(SourceError(f"{self._device}: capture failed: {exc}"))
+                    if not stop.is_set():
+                        self._finish(SourceError(f"{self._device}: capture failed: {exc}"))
                     return
                 t_ns = self._clock()
+                if stop.is_set():
+                    return
                 if not ok:
                     self._finish(None)
                     return
@@ -111,7 +118,9 @@ class OpenCVSource:
                 index += 1
                 with self._cond:
                     if not self._live:
-                        self._cond.wait_for(lambda: self._latest is None or self._stop.is_set())
+                        self._cond.wait_for(lambda: self._latest is None or stop.is_set())
+                    if stop.is_set():
+                        return
                     if self._latest is not None:
                         self._dropped += 1
                     self._latest = item
@@ -159,7 +168,7 @@ class OpenCVSource:
         self._stop.set()
         with self._cond:
             self._cond.notify_all()
-        thread.join(timeout=max(1.0, self._timeout_s))
+        thread.join(timeout=self._timeout_s)
         if thread.is_alive():
             _log.warning("grabber for %s still blocked in read(); leaving it to exit on its own",
                          self._device)

@@ -44,11 +44,13 @@ def camera_controls(cfg: SourceConfig) -> Dict[str, Any]:
     ``FrameDurationLimits`` (µs, min and max) is what libcamera takes; newer
     picamera2 also accepts ``FrameRate``, which it turns into the same thing.
     """
-    frame_us = int(round(1e6 / cfg.fps))
-    controls: Dict[str, Any] = {"FrameDurationLimits": (frame_us, frame_us)}
+    controls: Dict[str, Any] = {}
+    if cfg.fps > 0:  # 0 (e.g. --fps 0): the camera's own default
+        frame_us = round(1e6 / cfg.fps)
+        controls["FrameDurationLimits"] = (frame_us, frame_us)
     user = dict(cfg.controls)
     if "FrameRate" in user:
-        controls.pop("FrameDurationLimits")
+        controls.pop("FrameDurationLimits", None)
     controls.update(user)
     return controls
 
@@ -96,17 +98,19 @@ class Picamera2Source:
 
     Opening retries with exponential back-off (``backoff_s``, doubling, capped
     at ``max_backoff_s``) for ``cfg.retries`` more attempts when the camera is
-    missing or busy. A capture that times out (``cfg.timeout_s``) raises
-    FrameError; the ``cfg.retries``-th timeout in a row raises CameraError so
-    the daemon exits and systemd restarts it. ``close()`` gives stop/close
-    ``stop_timeout_s`` in a helper thread and logs if they hang.
+    missing or busy; a ``sleep`` that returns True (a set ``threading.Event``'s
+    ``wait``) stops the retries early. A capture that times out
+    (``cfg.timeout_s``) raises FrameError; the ``cfg.retries``-th timeout in a
+    row raises CameraError so the daemon exits and systemd restarts it.
+    ``close()`` gives stop/close ``stop_timeout_s`` in a helper thread and logs
+    if they hang.
     """
 
     def __init__(
         self,
         cfg: SourceConfig,
         *,
-        sleep: Callable[[float], None] = time.sleep,
+        sleep: Callable[[float], object] = time.sleep,
         clock: Callable[[], int] = time.monotonic_ns,
         backoff_s: float = 0.5,
         max_backoff_s: float = 8.0,
@@ -152,7 +156,8 @@ class Picamera2Source:
         except (RuntimeError, ValueError, KeyError, TypeError) as exc:
             self._cam = cam
             self.close()
-            raise CameraError(f"camera {cfg.camera_num}: cannot configure and start: {exc}") from exc
+            msg = f"camera {cfg.camera_num}: cannot configure and start: {exc}"
+            raise CameraError(msg) from exc
         self._cam = cam
         self._boot_offset_ns = _boot_offset_ns()
         self._prev_sensor_ns = None
@@ -174,7 +179,8 @@ class Picamera2Source:
                                     "is another process using it?")
             if attempt < attempts:
                 _log.warning("%s; retrying in %.1f s (%d of %d)", error, delay, attempt, attempts)
-                self._sleep(delay)
+                if self._sleep(delay):  # an Event.wait that was set: stop trying
+                    break
                 delay = min(delay * 2.0, self._max_backoff_s)
         raise error
 
@@ -186,7 +192,7 @@ class Picamera2Source:
             return "none"
 
     def read(self) -> Optional[Frame]:
-        """The newest frame; FrameError on one timeout, CameraError after ``cfg.retries`` in a row."""
+        """The newest frame; FrameError on a timeout, CameraError on ``cfg.retries`` in a row."""
         cam = self._cam
         if cam is None:
             raise SourceError("Picamera2 source is not open")
@@ -228,7 +234,8 @@ class Picamera2Source:
             sensor_ns = int(sensor_ns)
             t_ns = sensor_to_monotonic_ns(sensor_ns, received_ns, self._boot_offset_ns)
             duration_us = metadata.get("FrameDuration")
-            period_ns = duration_us * 1e3 if duration_us else 1e9 / self._cfg.fps
+            fps = self._cfg.fps
+            period_ns = duration_us * 1e3 if duration_us else (1e9 / fps if fps > 0 else 0.0)
             missed = frames_missed(self._prev_sensor_ns, sensor_ns, period_ns)
             self._dropped += missed
             self._next_index += missed

@@ -121,15 +121,18 @@ class _ImageDir:
         return self.paths[pos].name
 
     def get(self, pos: int) -> Fetched:
-        if self._cache is not None and pos in self._cache:
-            return self._cache[pos]
-        image = _decode(self.paths[pos])
-        if self._cache is not None:
+        if self._cache is None:
+            return _decode(self.paths[pos])
+        if pos in self._cache:
+            image = self._cache[pos]
+        else:
+            image = _decode(self.paths[pos])
             size = 0 if image is None else image.nbytes
             if self._cached_bytes + size <= _CACHE_BYTES:
                 self._cache[pos] = image
                 self._cached_bytes += size
-        return image
+        # A copy, so a consumer drawing on its frame cannot alter the next loop.
+        return None if image is None else image.copy()
 
     def close(self) -> None:
         self._cache = None
@@ -170,6 +173,43 @@ class _Video:
             self._cap = None
 
 
+class Pacer:
+    """Camera timing for sources without a camera: frame *i* is captured at start + i/fps."""
+
+    def __init__(
+        self, fps: float, clock: Callable[[], int], sleep: Callable[[float], object]
+    ) -> None:
+        self.fps = fps
+        self._clock = clock
+        self._sleep = sleep
+        self.start_ns = 0
+
+    def start(self) -> None:
+        self.start_ns = self._clock()
+
+    def capture_ns(self, i: int) -> int:
+        return self.start_ns + round(i * 1e9 / self.fps)
+
+    def next_index(self, i: int, last: Optional[int] = None) -> int:
+        """The frame to deliver when ``i`` is the first one not yet delivered.
+
+        Waits until ``i`` is due if the consumer is early (a ``sleep`` that
+        returns True, like ``threading.Event.wait`` once set, ends the wait);
+        otherwise returns the newest frame already due (at most ``last``, the
+        end of a finite stream), so ``result - i`` frames were dropped.
+        """
+        now = self._clock()
+        due = math.floor((now - self.start_ns) * self.fps / 1e9)
+        if due >= i:
+            return min(due, max(i, last)) if last is not None else due
+        t_due = self.capture_ns(i)
+        while now < t_due:
+            if self._sleep((t_due - now) / 1e9):
+                break
+            now = self._clock()
+        return i
+
+
 class RecordedSource:
     """Recorded frames served like a live camera.
 
@@ -189,15 +229,13 @@ class RecordedSource:
         fps: Optional[float] = None,
         loop: bool = False,
         clock: Callable[[], int] = time.monotonic_ns,
-        sleep: Callable[[float], None] = time.sleep,
+        sleep: Callable[[float], object] = time.sleep,
     ) -> None:
         self._path = path
-        self._fps = float(fps) if fps else 0.0
         self._loop = loop
         self._clock = clock
-        self._sleep = sleep
+        self._pacer = Pacer(float(fps), clock, sleep) if fps else None
         self._reader: Union[_ImageDir, _Video, None] = None
-        self._start_ns = 0
         self._next = 0
         self._dropped = 0
 
@@ -211,7 +249,8 @@ class RecordedSource:
             return
         p = _check_path(self._path)
         self._reader = _ImageDir(p, cache=self._loop) if p.is_dir() else _Video(p)
-        self._start_ns = self._clock()
+        if self._pacer is not None:
+            self._pacer.start()
         self._next = 0
         self._dropped = 0
 
@@ -226,15 +265,19 @@ class RecordedSource:
         if reader is None:
             raise SourceError("recorded source is not open")
         i = self._next
-        if self._fps > 0:
-            i = self._pace(i, reader.length)
+        if not self._loop and reader.length is not None and i >= reader.length:
+            return None  # the end: no point waiting for a frame that will never come
+        if self._pacer is not None:
+            last = None if self._loop or reader.length is None else reader.length - 1
+            i = self._pacer.next_index(i, last)
+            self._dropped += i - self._next
         fetched = self._fetch(reader, i)
-        last = None if reader.length is None else reader.length - 1
-        if fetched is None and i > self._next and last is not None and self._next <= last < i:
+        end = None if reader.length is None else reader.length - 1
+        if fetched is None and end is not None and self._next <= end < i:
             # A paced skip ran past the end of a video whose length was unknown:
             # deliver its last frame, as a camera would have.
-            self._dropped -= i - last
-            i = last
+            self._dropped -= i - end
+            i = end
             fetched = self._fetch(reader, i)
         if fetched is None:
             return None
@@ -243,28 +286,12 @@ class RecordedSource:
         name = reader.name(pos)
         if image is None:
             raise FrameError(f"{name}: cannot decode image")
-        t_ns = self._capture_ns(i) if self._fps > 0 else self._clock()
+        t_ns = self._pacer.capture_ns(i) if self._pacer is not None else self._clock()
         return Frame(image=image, t_mono_ns=t_ns, index=i, name=name)
 
-    def _capture_ns(self, i: int) -> int:
-        return self._start_ns + round(i * 1e9 / self._fps)
-
-    def _pace(self, i: int, length: Optional[int]) -> int:
-        """Index of the frame to deliver: wait for ``i`` if it is not due, else the newest due."""
-        now = self._clock()
-        due = math.floor((now - self._start_ns) * self._fps / 1e9)
-        if due >= i:
-            if not self._loop and length is not None:
-                due = min(due, max(i, length - 1))  # the stream ended while we were busy
-            self._dropped += due - i
-            return due
-        t_due = self._capture_ns(i)
-        while now < t_due:
-            self._sleep((t_due - now) / 1e9)
-            now = self._clock()
-        return i
-
-    def _fetch(self, reader: Union[_ImageDir, _Video], i: int) -> Optional[Tuple[int, Optional[np.ndarray]]]:
+    def _fetch(
+        self, reader: Union[_ImageDir, _Video], i: int
+    ) -> Optional[Tuple[int, Optional[np.ndarray]]]:
         for _ in range(2):  # a second try once a video's length has been learned
             length = reader.length
             if length is not None:

@@ -139,7 +139,9 @@ class _Job:
 class Picamera2:
     """The fake camera: see the module docstring for the behaviour it copies."""
 
-    def __init__(self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None) -> None:
+    def __init__(
+        self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None
+    ) -> None:
         with WORLD.lock:
             if not 0 <= camera_num < WORLD.num_cameras:
                 raise IndexError("list index out of range")  # global_camera_info()[camera_num]
@@ -223,7 +225,9 @@ class Picamera2:
         # Sensor time starts in the past so stamps stay behind time.monotonic_ns().
         self._t0_ns = time.monotonic_ns() - 5_000_000_000
 
-    def capture_request(self, wait: Any = None, signal_function: Any = None, flush: Any = None) -> Any:
+    def capture_request(
+        self, wait: Any = None, signal_function: Any = None, flush: Any = None
+    ) -> Any:
         job = _Job()
         with WORLD.lock:
             WORLD.capture_waits.append(wait)
@@ -302,7 +306,7 @@ def _to_format(rgb: np.ndarray, fmt: str) -> np.ndarray:
         return rgb[:, :, ::-1]  # [B, G, R]
     if fmt == "BGR888":
         return rgb
-    alpha = np.full(rgb.shape[:2] + (1,), 255, dtype=np.uint8)
+    alpha = np.full((*rgb.shape[:2], 1), 255, dtype=np.uint8)
     if fmt == "XBGR8888":
         return np.concatenate([rgb, alpha], axis=2)  # [R, G, B, 255]
     return np.concatenate([rgb[:, :, ::-1], alpha], axis=2)  # XRGB8888: [B, G, R, 255]

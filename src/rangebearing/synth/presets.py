@@ -1,0 +1,176 @@
+"""Random scenes for tests, benchmarks and demos, one preset per question asked.
+
+``paper``    one landmark where the paper measured: d_v 0.28–0.72 m, |θ| ≤ 25°.
+``wide``     one landmark anywhere it is wholly visible, 0.15–2 m, hard rooms and light.
+``clutter``  red and blue distractors; half the frames hold no landmark.
+``multi``    2–4 landmarks, 0.2–1.5 m, image extents apart (none occludes another).
+``sample``   two neighbours moving smoothly, as in a short recorded clip (30 fps).
+
+Every landmark a preset draws lies wholly inside the frame, so the truth of a
+frame is its scene's landmarks.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from typing import Iterator, List, Tuple
+
+import numpy as np
+
+from .._compat import frozen
+from ..core.types import CameraIntrinsics
+from ..errors import ConfigError
+from . import _draw as d
+from .camera import landmark_bbox_px
+from .clutter import clutter_scene
+from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
+
+PRESETS = ("paper", "wide", "clutter", "multi", "sample")
+SAMPLE_FPS = 30.0
+
+
+def _paper(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
+    base = Scene(camera=camera, lighting=d.lighting(rng), imaging=d.imaging(rng),
+                 **d.neutral_room(rng))
+    for _ in range(500):
+        d_v, theta = d.uniform(rng, 0.28, 0.72), math.radians(d.uniform(rng, -25.0, 25.0))
+        lm = LandmarkPose(d_v / math.cos(theta), theta)
+        if d.in_view(base, lm):
+            scene = dataclasses.replace(base, landmarks=(lm,))
+            return d.with_wall_behind(scene, rng, 0.15, 0.65)
+    raise d.give_up("paper", camera)
+
+
+def _wide(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
+    kind = d.LIGHTS[int(rng.integers(len(d.LIGHTS)))]
+    noise = {"dim": 2.5, "bright": 0.7}.get(kind, 1.0)
+    base = Scene(camera=camera, camera_height_m=d.uniform(rng, 0.09, 0.11),
+                 lighting=d.lighting(rng, kind), imaging=d.imaging(rng, noise, (0.0, 1.0)),
+                 **d.tinted_room(rng))
+    lm = d.draw_landmark(rng, base, lambda: d.log_uniform(rng, 0.15, 2.0), base_spread_m=0.02,
+                         attempts=1000)
+    if lm is None:
+        raise d.give_up("wide", camera)
+    return d.with_wall_behind(dataclasses.replace(base, landmarks=(lm,)), rng, 0.3, 1.5, 0.25)
+
+
+def _apart(scene: Scene, lm: LandmarkPose, placed: List[LandmarkPose], gap_px: float) -> bool:
+    box = landmark_bbox_px(scene, lm, with_robot=True)
+    if box is None:
+        return False
+    for other in placed:
+        ob = landmark_bbox_px(scene, other, with_robot=True)
+        if ob is None or min(box[2], ob[2]) - max(box[0], ob[0]) > -gap_px:
+            return False
+    return True
+
+
+def _multi(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
+    n = int(rng.integers(2, 5))
+    kind = ("normal", "normal", "warm", "cool")[int(rng.integers(4))]
+    room = d.tinted_room(rng) if rng.random() < 0.5 else d.neutral_room(rng)
+    base = Scene(camera=camera, lighting=d.lighting(rng, kind), imaging=d.imaging(rng), **room)
+    for _ in range(300):
+        placed: List[LandmarkPose] = []
+        for _ in range(n):
+            lm = d.draw_landmark(rng, base, lambda: d.log_uniform(rng, 0.2, 1.5), 0.01,
+                                 accept=lambda c, p=placed: _apart(base, c, p, 4.0), attempts=40)
+            if lm is None:
+                break
+            placed.append(lm)
+        if len(placed) == n:
+            placed.sort(key=lambda lm: -lm.bearing_rad)  # left to right in the image
+            scene = dataclasses.replace(base, landmarks=tuple(placed))
+            return d.with_wall_behind(scene, rng, 0.3, 1.0)
+    raise d.give_up("multi", camera)
+
+
+@frozen
+class Wander:
+    """One neighbour's smooth path: range and bearing each a sinusoid of time."""
+
+    range_m: float
+    range_amp_m: float
+    range_period_s: float
+    range_phase_rad: float
+    bearing_rad: float
+    bearing_amp_rad: float
+    bearing_period_s: float
+    bearing_phase_rad: float
+
+    def pose(self, t_s: float) -> LandmarkPose:
+        r = self.range_m + self.range_amp_m * math.sin(
+            2 * math.pi * t_s / self.range_period_s + self.range_phase_rad)
+        b = self.bearing_rad + self.bearing_amp_rad * math.sin(
+            2 * math.pi * t_s / self.bearing_period_s + self.bearing_phase_rad)
+        return LandmarkPose(r, b)
+
+
+def _wander(rng: np.random.Generator, side: float) -> Wander:
+    # ranges 0.40–0.85 m and |bearing| 0.15–0.35 rad keep the two robots' image
+    # extents apart and both landmarks inside a 640x480 frame at fx = 634.
+    u = functools.partial(d.uniform, rng)
+    return Wander(u(0.55, 0.70), u(0.05, 0.15), u(4.0, 7.0), u(0.0, 2 * math.pi),
+                  side * u(0.22, 0.28), u(0.03, 0.07), u(3.0, 6.0), u(0.0, 2 * math.pi))
+
+
+def sample_plan(rng: np.random.Generator, camera: CameraIntrinsics = DEFAULT_CAMERA
+                ) -> Tuple[Scene, Tuple[Wander, ...]]:
+    """The fixed part of a ``sample`` clip and the paths of its two neighbours."""
+    base = Scene(camera=camera, lighting=d.lighting(rng), imaging=d.imaging(rng, 1.0, (0.4, 0.7)),
+                 wall_distance_m=d.uniform(rng, 1.1, 1.5), **d.neutral_room(rng))
+    return base, (_wander(rng, 1.0), _wander(rng, -1.0))
+
+
+def sample_scene(base: Scene, paths: Tuple[Wander, ...], t_s: float) -> Scene:
+    """The ``sample`` clip at time ``t_s``: the neighbours wholly in view at that moment."""
+    poses = tuple(p.pose(t_s) for p in paths)
+    visible = tuple(lm for lm in poses if d.in_view(base, lm, 0.0))
+    return dataclasses.replace(base, landmarks=visible)
+
+
+def random_scene(rng: np.random.Generator, preset: str,
+                 camera: CameraIntrinsics = DEFAULT_CAMERA) -> Scene:
+    """Draw one scene of a preset (see the module docstring).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The only source of randomness; the same state gives the same scene.
+    preset : str
+        One of :data:`PRESETS`.
+    camera : CameraIntrinsics
+        Placement keeps every landmark wholly inside this camera's frame.
+
+    Raises
+    ------
+    ConfigError
+        Unknown preset, or a camera too small to place the landmarks in.
+    """
+    if preset == "paper":
+        return _paper(rng, camera)
+    if preset == "wide":
+        return _wide(rng, camera)
+    if preset == "clutter":
+        return clutter_scene(rng, camera)
+    if preset == "multi":
+        return _multi(rng, camera)
+    if preset == "sample":
+        base, paths = sample_plan(rng, camera)
+        return sample_scene(base, paths, d.uniform(rng, 0.0, 60.0))
+    raise ConfigError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
+
+
+def scene_sequence(rng: np.random.Generator, preset: str, frames: int,
+                   camera: CameraIntrinsics = DEFAULT_CAMERA) -> Iterator[Scene]:
+    """``frames`` scenes: independent draws, or consecutive 30 fps moments for ``sample``."""
+    if preset != "sample":
+        for _ in range(frames):
+            yield random_scene(rng, preset, camera)
+        return
+    base, paths = sample_plan(rng, camera)
+    t0 = d.uniform(rng, 0.0, 60.0)
+    for i in range(frames):
+        yield sample_scene(base, paths, t0 + i / SAMPLE_FPS)

@@ -1,0 +1,167 @@
+"""What a synthetic frame shows: frozen scene descriptions with exact geometry.
+
+World frame: camera centre at ``(0, camera_height_m, 0)``, X to the camera's
+right, Y up, Z forward along the (horizontal) optical axis. A landmark at range
+``r`` and bearing ``θ`` (positive to the LEFT) has its axis at
+``X = -r·sin θ, Z = r·cos θ``. Colours are linear RGB reflectances in [0, 1].
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional, Tuple
+
+from .._compat import frozen
+from ..core.types import CameraIntrinsics, LandmarkGeometry
+from ..errors import ConfigError
+
+RGB = Tuple[float, float, float]
+
+RED_PAINT: RGB = (0.70, 0.07, 0.06)
+BLUE_PAINT: RGB = (0.06, 0.12, 0.65)
+WHITE_PAINT: RGB = (0.85, 0.85, 0.85)
+CAP_GREY: RGB = (0.45, 0.45, 0.45)
+ROBOT_BODY: RGB = (0.06, 0.06, 0.06)
+ROBOT_TOP: RGB = (0.13, 0.13, 0.13)
+
+DEFAULT_CAMERA_HEIGHT_M = 0.10
+DEFAULT_BASE_HEIGHT_M = 0.065
+DEFAULT_ROBOT_RADIUS_M = 0.05
+DEFAULT_CAMERA = CameraIntrinsics()
+
+
+@frozen
+class LandmarkPose:
+    """One neighbour: its landmark's axis position and the height of its base.
+
+    The robot under it is a dark cylinder from the floor up to ``base_height_m``.
+    """
+
+    range_m: float
+    bearing_rad: float
+    base_height_m: float = DEFAULT_BASE_HEIGHT_M
+
+    @property
+    def x_m(self) -> float:
+        """World X of the axis (negative = left of the camera)."""
+        return -self.range_m * math.sin(self.bearing_rad)
+
+    @property
+    def z_m(self) -> float:
+        """World Z of the axis: the depth along the optical axis (the paper's d_v)."""
+        return self.range_m * math.cos(self.bearing_rad)
+
+
+@frozen
+class Cylinder:
+    """A plain vertical cylinder of one colour (a distractor)."""
+
+    x_m: float
+    z_m: float
+    radius_m: float
+    bottom_m: float
+    top_m: float
+    colour: RGB
+
+
+@frozen
+class Box:
+    """An axis-aligned box of one colour (a distractor); ``x_m, z_m`` is its centre."""
+
+    x_m: float
+    z_m: float
+    width_m: float
+    depth_m: float
+    bottom_m: float
+    top_m: float
+    colour: RGB
+
+
+@frozen
+class FloorPatch:
+    """A rectangle of another colour on the floor (a rug, a tile)."""
+
+    x_min_m: float
+    x_max_m: float
+    z_min_m: float
+    z_max_m: float
+    colour: RGB
+
+
+@frozen
+class Poster:
+    """A rectangle of another colour on the back wall."""
+
+    x_min_m: float
+    x_max_m: float
+    bottom_m: float
+    top_m: float
+    colour: RGB
+
+
+@frozen
+class Lighting:
+    """A directional light plus ambient, and the camera's exposure and white balance.
+
+    ``direction`` points from the scene towards the light (world frame, need
+    not be unit length). Radiance = albedo · (ambient + (1 − ambient)·max(0, n·l)).
+    """
+
+    direction: Tuple[float, float, float] = (-0.35, 0.75, -0.55)
+    ambient: float = 0.40
+    exposure: float = 1.25
+    wb_gains: RGB = (1.0, 1.0, 1.0)
+
+
+@frozen
+class Imaging:
+    """The sensor and lens: blur, noise (in linear units of full scale) and gamma."""
+
+    blur_sigma_px: float = 0.0
+    read_noise: float = 0.0
+    shot_noise: float = 0.0
+    gamma: float = 1.0 / 2.2
+
+
+@frozen
+class Scene:
+    """Everything one frame shows. ``wall_distance_m=None`` is an open room.
+
+    Examples
+    --------
+    >>> scene = Scene(landmarks=(LandmarkPose(0.5, math.radians(10)),))
+    """
+
+    camera: CameraIntrinsics = CameraIntrinsics()
+    camera_height_m: float = DEFAULT_CAMERA_HEIGHT_M
+    landmarks: Tuple[LandmarkPose, ...] = ()
+    geometry: LandmarkGeometry = LandmarkGeometry()
+    robot_radius_m: float = DEFAULT_ROBOT_RADIUS_M
+    cylinders: Tuple[Cylinder, ...] = ()
+    boxes: Tuple[Box, ...] = ()
+    floor_colour: RGB = (0.60, 0.60, 0.60)
+    floor_patches: Tuple[FloorPatch, ...] = ()
+    wall_distance_m: Optional[float] = 1.2
+    wall_colour: RGB = (0.78, 0.78, 0.78)
+    posters: Tuple[Poster, ...] = ()
+    background_colour: RGB = (0.30, 0.30, 0.30)
+    lighting: Lighting = Lighting()
+    imaging: Imaging = Imaging()
+
+    def __post_init__(self) -> None:
+        problems = []
+        if not self.camera_height_m > 0:
+            problems.append(f"camera_height_m must be > 0, got {self.camera_height_m}")
+        if self.wall_distance_m is not None and not self.wall_distance_m > 0:
+            problems.append(f"wall_distance_m must be > 0 or None, got {self.wall_distance_m}")
+        for i, lm in enumerate(self.landmarks):
+            if not lm.range_m > 0:
+                problems.append(f"landmarks[{i}].range_m must be > 0, got {lm.range_m}")
+            if not lm.base_height_m >= 0:
+                problems.append(f"landmarks[{i}].base_height_m must be >= 0")
+        for name in ("cylinders", "boxes"):
+            for i, obj in enumerate(getattr(self, name)):
+                if not obj.top_m > obj.bottom_m:
+                    problems.append(f"{name}[{i}]: top_m must be above bottom_m")
+        if problems:
+            raise ConfigError(problems, "synthetic scene")
