@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import collections
-from typing import Deque, Dict, Optional
+from typing import Deque, Dict
 
 import numpy as np
 
@@ -42,9 +42,7 @@ class LoopStats:
         self.latency_ns: Deque[int] = collections.deque(maxlen=window)
         self.stage_ns: Dict[str, Deque[int]] = {}
         self._window = window
-        self._rate_start_ns: Optional[int] = None
-        self._rate_frames = 0
-        self.fps = 0.0
+        self._done_ns: Deque[int] = collections.deque(maxlen=64)
 
     def frame_done(self, now_ns: int, latency_ns: int, landmarks: int, stages_ns: Dict[str, int]) -> None:
         self.frames += 1
@@ -52,13 +50,13 @@ class LoopStats:
         self.latency_ns.append(latency_ns)
         for name, ns in stages_ns.items():
             self.stage_ns.setdefault(name, collections.deque(maxlen=self._window)).append(ns)
-        if self._rate_start_ns is None:
-            self._rate_start_ns = now_ns
-        self._rate_frames += 1
-        elapsed = now_ns - self._rate_start_ns
-        if elapsed >= 1_000_000_000:
-            self.fps = (self._rate_frames - 1) * 1e9 / elapsed if self._rate_frames > 1 else 0.0
-            self._rate_start_ns, self._rate_frames = now_ns, 1
+        self._done_ns.append(now_ns)
+
+    @property
+    def fps(self) -> float:
+        """Frames per second over the last 64 frames."""
+        d = self._done_ns
+        return (len(d) - 1) * 1e9 / (d[-1] - d[0]) if len(d) > 1 and d[-1] > d[0] else 0.0
 
     def summary(self, dropped: int) -> Summary:
         lat = np.asarray(self.latency_ns, dtype=np.float64) / 1e6

@@ -9,7 +9,8 @@ from typing import Any, Dict
 import pytest
 
 import rangebearing.net.protocol as protocol
-from rangebearing.net.protocol import encode_reading
+from rangebearing.cli.listen_cmd import format_reading
+from rangebearing.net.protocol import decode_reading, encode_reading
 
 from .factories import make_landmark
 
@@ -55,3 +56,13 @@ def test_full_validation_when_jsonschema_is_installed(schema: Dict[str, Any]) ->
     bad = json.loads(encode_reading("zumo", 0, 1.0))
     bad["v"] = 2
     assert not validator.is_valid(bad)
+
+
+def test_the_documented_example_is_a_valid_reading() -> None:
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "protocol.md").read_text("utf-8")
+    block = doc.split("```json\n", 1)[1].split("```", 1)[0]
+    data = "".join(line.strip() for line in block.splitlines()).encode()
+    reading = decode_reading(data)
+    assert f"({len(data)} bytes on the" in doc
+    assert format_reading(reading) in doc
+    assert reading.to_bytes() == data

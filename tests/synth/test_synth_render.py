@@ -52,6 +52,7 @@ def test_bearing_zero_projects_the_axis_to_column_cx():
     (rx, ry), (bx, by) = bands(render_linear(scene), scene, lm)
     assert rx == pytest.approx(CAM.cx_px, abs=0.01)
     assert bx == pytest.approx(CAM.cx_px, abs=0.01)
+    assert ry < CAM.cy_px < by  # the camera (0.10 m) is between the bands
 
 
 @pytest.mark.parametrize("theta_deg", [5.0, 15.0, 24.0])
@@ -73,8 +74,8 @@ def test_negative_bearing_mirrors_positive():
     sr = Scene(landmarks=(right,), lighting=FLAT, **OPEN)
     (lx, ly), _ = bands(render_linear(sl), sl, left)
     (rx, ry), _ = bands(render_linear(sr), sr, right)
-    assert lx - CAM.cx_px == pytest.approx(-(rx - CAM.cx_px), abs=0.01)
-    assert ly == pytest.approx(ry, abs=0.01)
+    assert lx - CAM.cx_px == pytest.approx(-(rx - CAM.cx_px), abs=0.05)
+    assert ly == pytest.approx(ry, abs=0.05)
 
 
 @pytest.mark.parametrize("range_m", [0.3, 0.5, 1.0, 1.8])
@@ -84,6 +85,7 @@ def test_red_above_blue_and_band_spacing_follows_depth(range_m):
     red, blue = uint8_red_blue(render(scene))
     (rx, ry), (bx, by) = centroid(red), centroid(blue)
     assert ry < by  # red on top: smaller row index
+    assert rx == pytest.approx(bx, abs=0.5)  # one above the other
     spacing = by - ry
     assert spacing == pytest.approx(CAM.fy_px * 0.055 / lm.z_m, rel=0.07)
     # the visible face is nearer than the axis by about πR/4 (the model's c term)
@@ -118,7 +120,7 @@ def test_supersampling_makes_sub_pixel_motion_smooth():
         return xs, np.abs(xs - fit).max()
     xs, residual = track(4)
     assert np.all(np.diff(xs) < 0)  # bearing grows: the band moves left
-    assert residual < 0.01
+    assert residual < 0.02
     _, aliased = track(1)
     assert aliased > 3 * residual
 
@@ -142,7 +144,7 @@ def test_wall_hides_what_is_behind_it():
 
 
 def test_red_distractor_is_red_and_opaque():
-    scene = Scene(cylinders=(Cylinder(0.0, 0.5, 0.03, 0.0, 0.12, (0.7, 0.07, 0.06)),))
+    scene = Scene(cylinders=(Cylinder(0.0, 0.5, 0.03, 0.0, 0.12, (0.7, 0.07, 0.06)),), lighting=FLAT)
     red, blue = uint8_red_blue(render(scene))
     assert red.sum() > 0 and blue.sum() == 0
     x, _ = centroid(red)

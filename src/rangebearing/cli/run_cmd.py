@@ -79,6 +79,10 @@ def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
     return open_source(cfg.source, cfg.camera, sleep=sleep)
 
 
+def publisher_for(cfg: Config) -> UdpPublisher:
+    return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
+
+
 def run(args: argparse.Namespace) -> int:
     cfg = load_config(args.config) if args.config else Config()
     override = source_from_args(args, cfg.source)
@@ -93,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
     daemon = Daemon(
-        cfg, source_opener, UdpPublisher, Notifier(), config_path=args.config, echo=echo, source_override=override
+        cfg, source_opener, publisher_for, Notifier(), config_path=args.config, echo=echo, source_override=override
     )
     daemon.install_signal_handlers()
     dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)

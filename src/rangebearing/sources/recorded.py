@@ -267,11 +267,15 @@ class RecordedSource:
         i = self._next
         if not self._loop and reader.length is not None and i >= reader.length:
             return None  # the end: no point waiting for a frame that will never come
+        ahead = None
         if self._pacer is not None:
+            # Decode before the frame is due, as a camera delivers frames ready to use,
+            # so capture-to-send latency measures the pipeline, not the PNG decoder.
+            ahead = self._fetch(reader, i)
             last = None if self._loop or reader.length is None else reader.length - 1
             i = self._pacer.next_index(i, last)
             self._dropped += i - self._next
-        fetched = self._fetch(reader, i)
+        fetched = ahead if ahead is not None and i == self._next else self._fetch(reader, i)
         end = None if reader.length is None else reader.length - 1
         if fetched is None and end is not None and self._next <= end < i:
             # A paced skip ran past the end of a video whose length was unknown:

@@ -153,7 +153,7 @@ def pixel_rect(camera: CameraIntrinsics, xn: Sequence[float], yn: Sequence[float
 def cylinder_bbox_px(scene: Scene, x_m: float, z_m: float, radius_m: float, bottom_m: float,
                      top_m: float) -> Optional[BoxPx]:
     """Image extent ``(u0, v0, u1, v1)`` of a vertical cylinder, unclipped; None if behind."""
-    ang = np.linspace(0.0, 2.0 * np.pi, 96, endpoint=False)
+    ang = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
     heights = np.linspace(bottom_m, top_m, 7)
     xs = (x_m + radius_m * np.cos(ang))[None, :] + 0.0 * heights[:, None]
     zs = (z_m + radius_m * np.sin(ang))[None, :] + 0.0 * heights[:, None]

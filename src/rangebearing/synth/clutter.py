@@ -13,7 +13,7 @@ from __future__ import annotations
 import colorsys
 import dataclasses
 import math
-from typing import List, Optional, Tuple
+from typing import List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -94,11 +94,20 @@ def landmark_like(red: BoxPx, blue: BoxPx) -> bool:
     return red_v < blue_v and blue_v - red_v < 5.0 * width
 
 
-def _footprint(obj: object) -> Tuple[float, float, float]:
+Solid = Union[Cylinder, Box]
+
+
+def _footprint(obj: Solid) -> Tuple[float, float, float, float, float]:
+    """``(x, z, radius, bottom, top)`` of a bounding vertical cylinder."""
     if isinstance(obj, Cylinder):
-        return obj.x_m, obj.z_m, obj.radius_m
-    assert isinstance(obj, Box)
-    return obj.x_m, obj.z_m, math.hypot(obj.width_m, obj.depth_m) / 2
+        return obj.x_m, obj.z_m, obj.radius_m, obj.bottom_m, obj.top_m
+    return obj.x_m, obj.z_m, math.hypot(obj.width_m, obj.depth_m) / 2, obj.bottom_m, obj.top_m
+
+
+def _collide(a: Tuple[float, ...], b: Tuple[float, ...]) -> bool:
+    apart = math.hypot(a[0] - b[0], a[1] - b[1]) >= a[2] + b[2] + 0.01
+    stacked = a[3] >= b[4] - 1e-9 or b[3] >= a[4] - 1e-9
+    return not (apart or stacked)
 
 
 def layout_ok(scene: Scene) -> bool:
@@ -108,21 +117,23 @@ def layout_ok(scene: Scene) -> bool:
     blues = [b for c, b in found if c == "blue"]
     if any(landmark_like(r, b) for r in reds for b in blues):
         return False
-    objects: List[object] = [*scene.cylinders, *scene.boxes]
+    objects: List[Solid] = [*scene.cylinders, *scene.boxes]
     feet = [_footprint(o) for o in objects]
-    feet += [(lm.x_m, lm.z_m, scene.robot_radius_m) for lm in scene.landmarks]
-    for i, (x1, z1, r1) in enumerate(feet):
-        for x2, z2, r2 in feet[:i]:
-            if math.hypot(x1 - x2, z1 - z2) < r1 + r2 + 0.01:
-                return False
-    if scene.wall_distance_m is not None and any(z + r > scene.wall_distance_m for _, z, r in feet):
+    g = scene.geometry
+    feet += [(lm.x_m, lm.z_m, scene.robot_radius_m, 0.0, lm.base_height_m + g.height_m)
+             for lm in scene.landmarks]
+    if any(_collide(a, b) for i, a in enumerate(feet) for b in feet[:i]):
         return False
+    if scene.wall_distance_m is not None and any(f[1] + f[2] > scene.wall_distance_m
+                                                 for f in feet):
+        return False
+    others = [b for _, b in found] + [cylinder_bbox_px(scene, *_footprint(o)[:3], 0.0, 1.0)
+                                      for o in objects]
     for lm in scene.landmarks:
         box = landmark_bbox_px(scene, lm, with_robot=True)
-        assert box is not None
-        everything = [b for _, b in found] + [
-            cylinder_bbox_px(scene, *_footprint(o)[:3], 0.0, 1.0) for o in objects]
-        for other in everything:
+        if box is None:
+            return False
+        for other in others:
             if other is not None and min(box[2], other[2]) - max(box[0], other[0]) > -GAP_PX:
                 return False
     return True

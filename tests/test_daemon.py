@@ -1,0 +1,174 @@
+"""The capture loop in-process: readings, faults survived, and the Picamera2 source via the fake."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import shutil
+import socket
+import threading
+import time
+from pathlib import Path
+from typing import List
+
+import cv2
+import numpy as np
+import pytest
+
+from tests.conftest import STATIC_SCENE
+from rangebearing.config import Config, PublishConfig, SourceConfig
+from rangebearing.daemon import Daemon
+from rangebearing.net.protocol import decode_reading
+from rangebearing.net.publisher import MemoryPublisher, UdpPublisher
+from rangebearing.sources.base import open_source
+from rangebearing.synth import render
+
+
+class RecordingNotifier:
+    """Stands in for sdnotify.Notifier and remembers what the daemon said."""
+
+    def __init__(self, watchdog_s: float = 0.0) -> None:
+        self.calls: List[str] = []
+        self._wd = watchdog_s
+
+    def ready(self, status=None):
+        self.calls.append("READY")
+
+    def watchdog(self):
+        self.calls.append("WATCHDOG")
+
+    def status(self, text):
+        self.calls.append("STATUS")
+
+    def stopping(self):
+        self.calls.append("STOPPING")
+
+    def reloading(self):
+        self.calls.append("RELOADING")
+
+    def watchdog_interval_s(self):
+        return self._wd or None
+
+
+def opener(cfg, sleep):
+    return open_source(cfg.source, cfg.camera, sleep=sleep)
+
+
+def recorded_cfg(path: Path, **source) -> Config:
+    src = dataclasses.replace(SourceConfig(), kind="recorded", path=str(path), fps=0.0, **source)
+    return dataclasses.replace(Config(), source=src)
+
+
+def assert_matches_static_truth(payload: bytes) -> None:
+    reading = decode_reading(payload)
+    truth = sorted(STATIC_SCENE.landmarks, key=lambda lm: lm.range_m)
+    assert len(reading.landmarks) == len(truth)
+    for got, want in zip(reading.landmarks, truth):
+        assert got.range_m == pytest.approx(want.range_m, rel=0.02)
+        assert got.bearing_rad == pytest.approx(want.bearing_rad, abs=math.radians(0.3))
+
+
+def test_every_frame_of_a_clip_is_published_with_its_readings(static_clip):
+    pub, note = MemoryPublisher(), RecordingNotifier(watchdog_s=1e-6)
+    daemon = Daemon(recorded_cfg(static_clip), opener, lambda cfg: pub, note)
+    assert daemon.run() == 0
+    assert len(pub.payloads) == 12 and pub.closed
+    assert [decode_reading(p).seq for p in pub.payloads] == list(range(12))
+    for p in pub.payloads:
+        assert_matches_static_truth(p)
+    assert note.calls[0] == "READY" and "WATCHDOG" in note.calls and note.calls[-1] == "STOPPING"
+    s = daemon.summary()
+    assert s.frames == 12 and s.bad_frames == 0 and s.latency_ms_p99 > 0
+
+
+def test_a_corrupt_frame_is_skipped_and_counted(static_clip, tmp_path):
+    clip = tmp_path / "clip"
+    shutil.copytree(static_clip, clip)
+    (clip / "000005b.png").write_bytes(b"\x89PNG\r\n\x1a\n not really")
+    cv2.imwrite(str(clip / "000006b.png"), np.zeros((4, 4, 3), np.uint8))  # too small to be a frame
+    pub = MemoryPublisher()
+    daemon = Daemon(recorded_cfg(clip), opener, lambda cfg: pub, RecordingNotifier())
+    assert daemon.run() == 0
+    assert daemon.stats.bad_frames == 2
+    assert len(pub.payloads) == 12
+
+
+def test_a_missing_udp_receiver_never_stops_the_daemon(static_clip):
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        dead_port = s.getsockname()[1]
+    cfg = dataclasses.replace(
+        recorded_cfg(static_clip, loop=True), publish=PublishConfig(unicast=(("127.0.0.1", dead_port),))
+    )
+    publishers = []
+
+    def open_pub(c):
+        publishers.append(UdpPublisher(c.publish))
+        return publishers[-1]
+
+    seen = []
+    daemon = Daemon(cfg, opener, open_pub, RecordingNotifier())
+    daemon.echo = lambda payload: (seen.append(payload), len(seen) >= 30 and daemon.stop())
+    assert daemon.run() == 0
+    assert len(seen) == 30
+    assert publishers[0].stats.total_errors > 0  # refused sends were counted, not raised
+
+
+def test_stop_from_another_thread_ends_a_paced_source_promptly(static_clip):
+    cfg = recorded_cfg(static_clip, loop=True)
+    cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, fps=2.0))  # long waits between frames
+    daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    t = threading.Thread(target=daemon.run)
+    t.start()
+    time.sleep(0.3)
+    t0 = time.monotonic()
+    daemon.stop()
+    t.join(5)
+    assert not t.is_alive() and time.monotonic() - t0 < 1.0
+
+
+def picamera_cfg(**source) -> Config:
+    fields = {"kind": "picamera2", "fps": 30.0, "timeout_s": 0.2, "retries": 3, **source}
+    src = dataclasses.replace(SourceConfig(), **fields)
+    return dataclasses.replace(Config(), source=src)
+
+
+def static_rgb(seq: int, height: int, width: int) -> np.ndarray:
+    bgr = render(STATIC_SCENE, np.random.default_rng(seq))
+    return np.ascontiguousarray(bgr[:, :, ::-1])  # the fake's producer speaks RGB, like the scene
+
+
+def test_picamera2_source_runs_through_the_loop_and_survives_a_capture_timeout(fake_picamera2):
+    world = fake_picamera2.WORLD
+    world.producer = static_rgb
+    seen: List[bytes] = []
+    daemon = Daemon(picamera_cfg(), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+
+    def echo(payload: bytes) -> None:
+        seen.append(payload)
+        if len(seen) == 3:  # stall the sensor once: one capture times out, then frames resume
+            world.set_stalled(True)
+            threading.Timer(0.3, world.set_stalled, args=(False,)).start()
+        if len(seen) >= 8:
+            daemon.stop()
+
+    daemon.echo = echo
+    assert daemon.run() == 0
+    assert len(seen) == 8
+    assert daemon.stats.bad_frames >= 1  # the timed-out capture, skipped and counted
+    for p in seen:
+        assert_matches_static_truth(p)  # RGB888 arrives as BGR and is used as such
+
+
+def test_a_missing_camera_ends_the_run_with_a_failure(fake_picamera2, caplog):
+    fake_picamera2.WORLD.num_cameras = 0
+    daemon = Daemon(picamera_cfg(retries=0), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    assert daemon.run() == 1
+    assert "no camera 0" in caplog.text
+
+
+def test_a_camera_that_keeps_timing_out_ends_the_run(fake_picamera2, caplog):
+    fake_picamera2.WORLD.stalled = True
+    daemon = Daemon(picamera_cfg(retries=2), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    assert daemon.run() == 1
+    assert "giving up" in caplog.text
