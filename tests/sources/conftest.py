@@ -1,4 +1,4 @@
-"""Fixtures for the frame-source tests: the picamera2 fake and tiny recordings."""
+"""Fixtures for the frame-source tests: tiny recordings (the picamera2 fake is in tests/conftest.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from typing import List
 import cv2
 import numpy as np
 import pytest
+
 
 def solid_bgr(value: int, height: int = 48, width: int = 64) -> np.ndarray:
     """A frame whose every pixel is ``value`` in all channels."""
