@@ -188,3 +188,16 @@ def test_band_centroid_column_tracks_bearing(range_m, frac):
     expected = CAM.cx_px - CAM.fx_px * math.tan(theta)
     tol = 0.3 + CAM.fx_px * 0.0175**2 / (range_m * lm.z_m)  # second-order silhouette offset
     assert abs(rx - expected) < tol and abs(bx - expected) < tol
+
+
+@pytest.mark.parametrize("range_m", [3.0, 6.0])
+def test_far_landmark_bands_thinner_than_two_pixels_keep_their_area(range_m):
+    lm = LandmarkPose(range_m, 0.05)
+    scene = Scene(landmarks=(lm,), lighting=FLAT, **OPEN)
+    lin = render_linear(scene)
+    red_area = band_weights(lin, "red").sum() / (0.70 - 0.07)
+    blue_area = band_weights(lin, "blue").sum() / (0.65 - 0.12)
+    width = 2 * CAM.fx_px * math.tan(math.asin(0.0175 / range_m))
+    expected = width * CAM.fy_px * 0.015 / lm.z_m
+    assert red_area == pytest.approx(expected, rel=0.03)
+    assert blue_area == pytest.approx(expected, rel=0.03)

@@ -6,6 +6,7 @@ All functions take and return numpy arrays and do no I/O. Hue follows OpenCV's
 
 from __future__ import annotations
 
+import functools
 from typing import Sequence, Tuple
 
 import cv2
@@ -65,36 +66,42 @@ def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> 
     return mask
 
 
+@functools.lru_cache(maxsize=16)
+def _ramp_table(lo: int, width: int) -> np.ndarray:
+    """float32 lookup table: 0 at ``lo`` rising linearly to 1 at ``lo + width``."""
+    return np.clip((np.arange(256, dtype=np.float32) - lo) / float(width), 0.0, 1.0).reshape(256, 1)
+
+
 def soft_weights(
     hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int, ramp: int = 40
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Per-pixel band membership in [0, 1] for sub-pixel moments: ``(w_x, w_y)``, float32.
 
-    Both are zero outside the hue ranges.
+    Both are zero outside the hue ranges (and for pixels darker than 10).
 
     ``w_x`` weighs by saturation on a linear ramp from ``s_min - ramp`` (0) to
     ``s_min + ramp`` (1). Saturation does not depend on brightness, so the
     shading across the cylinder does not pull the *horizontal* centroid.
 
     ``w_y`` weighs by chroma (max − min channel, i.e. S·V) relative to the
-    band's own chroma (its 80th percentile), above a floor. Chroma is linear in the share of
-    a pixel the band covers whether the neighbour is the white body or the
-    dark robot below, so the *vertical* centroid, and with it L, is unbiased;
+    band's own mean chroma, above a floor. Chroma is linear in the share of a
+    pixel the band covers whether the neighbour is the white body or the dark
+    robot below, so the *vertical* centroid, and with it L, is unbiased;
     saturation would count a blue/black edge pixel as fully blue.
     """
+    gate = hue_mask(hsv, hue_ranges, 1, min(v_min, 10))
+    s, v = hsv[:, :, 1], hsv[:, :, 2]
     loose_s = max(0, s_min - ramp)
-    hue_ok = hue_mask(hsv, hue_ranges, 1, 1) > 0
-    s = hsv[:, :, 1].astype(np.float32)
-    w_x = np.clip((s - loose_s) * (1.0 / (2 * ramp)), 0.0, 1.0)
-    w_x[~hue_ok | (hsv[:, :, 2] < v_min)] = 0.0
-    chroma = s * hsv[:, :, 2]
-    core = chroma[hue_ok & (s >= s_min)]
-    ref = float(np.percentile(core, 80)) if core.size else 0.0
+    w_x = cv2.LUT(s, _ramp_table(loose_s, 2 * ramp))
+    w_x[gate == 0] = 0.0
+    chroma = cv2.multiply(s, v, dtype=cv2.CV_32F)
+    core = cv2.bitwise_and(gate, cv2.compare(s, s_min, cv2.CMP_GE))
+    ref = cv2.mean(chroma, mask=core)[0]
     if ref <= 0.0:
         return w_x, w_x
     # An affine ramp with a floor: faint blends count the same on either side of
     # the band, and the chroma noise of neutral pixels counts not at all.
     floor = CHROMA_FLOOR * ref
     w_y = np.clip((chroma - floor) * (1.0 / (ref - floor)), 0.0, 1.0)
-    w_y[~hue_ok] = 0.0
+    w_y[gate == 0] = 0.0
     return w_x, w_y

@@ -4,8 +4,8 @@ Half the frames hold one landmark, half none. Distractors: red-only and
 blue-only cylinders and boxes, a red box high on a pedestal above a blue
 cylinder, red and blue cylinders side by side, a red poster on the wall,
 large tinted floor regions. :func:`landmark_like` is the rule every layout
-must pass: no red region sits above a blue one, horizontally overlapping it,
-closer than five widths (a landmark's band centres are 1.6 widths apart).
+must pass: no red region overlaps a blue one horizontally while their centres
+are closer than five widths vertically (a landmark's bands: 1.6 widths).
 """
 
 from __future__ import annotations
@@ -86,12 +86,17 @@ def regions(scene: Scene) -> List[Tuple[str, BoxPx]]:
 
 
 def landmark_like(red: BoxPx, blue: BoxPx) -> bool:
-    """Whether a red region above a blue one could pass for a landmark."""
+    """Whether a red and a blue region could pair up as a landmark's bands.
+
+    Conservative: any red and blue regions that overlap horizontally (or come
+    within ``GAP_PX``) with centres less than five widths apart vertically, in
+    either order (occlusion can cut a red top off a blue-fronted object).
+    """
     if min(red[2], blue[2]) - max(red[0], blue[0]) < -GAP_PX:
         return False  # side by side
     red_v, blue_v = (red[1] + red[3]) / 2, (blue[1] + blue[3]) / 2
     width = max(red[2] - red[0], blue[2] - blue[0], 1.0)
-    return red_v < blue_v and blue_v - red_v < 5.0 * width
+    return abs(blue_v - red_v) < 5.0 * width
 
 
 Solid = Union[Cylinder, Box]

@@ -121,6 +121,8 @@ def write_dataset(out_dir: Union[str, os.PathLike], frames: int, seed: int,
     """
     _check(frames, seed, preset, fmt, jpeg_quality)
     out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(f"{out} exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     stale = sorted(p for p in out.iterdir() if _FRAME_FILE.match(p.name) or p.name == TRUTH_FILE)
     if stale and not overwrite:

@@ -39,9 +39,9 @@ class Hits:
 
 @dataclass(frozen=True)
 class Shader:
-    """Lambertian shading with a unit light direction ``l`` and an ambient floor."""
+    """Lambertian shading with a unit direction towards the light and an ambient floor."""
 
-    l: np.ndarray  # noqa: E741
+    light: np.ndarray
     ambient: float
 
     @classmethod
@@ -130,23 +130,23 @@ def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader
         t = np.where(dy < 0, h / -dy, np.inf)
     palette = np.zeros((ID_POSTER + len(scene.posters), 3))
     palette[ID_BACKGROUND] = scene.background_colour
-    palette[ID_FLOOR] = shade(np.asarray(scene.floor_colour), np.asarray(shade.l[1]))
+    palette[ID_FLOOR] = shade(np.asarray(scene.floor_colour), np.asarray(shade.light[1]))
     ident = np.where(np.isfinite(t), ID_FLOOR, ID_BACKGROUND).astype(np.int32)
     if scene.floor_patches:
         x = dx * t
         for i, p in enumerate(scene.floor_patches):
-            palette[ID_PATCH + i] = shade(np.asarray(p.colour), np.asarray(shade.l[1]))
+            palette[ID_PATCH + i] = shade(np.asarray(p.colour), np.asarray(shade.light[1]))
             m = (x >= p.x_min_m) & (x <= p.x_max_m) & (t >= p.z_min_m) & (t <= p.z_max_m)
             ident[m] = ID_PATCH + i
     if zw is not None:
         wall = zw < t
         t = np.where(wall, zw, t)
         ident[wall] = ID_WALL
-        palette[ID_WALL] = shade(np.asarray(scene.wall_colour), np.asarray(-shade.l[2]))
+        palette[ID_WALL] = shade(np.asarray(scene.wall_colour), np.asarray(-shade.light[2]))
         if scene.posters:
             x, y = dx * zw, h + dy * zw
             for i, p in enumerate(scene.posters):
-                palette[ID_POSTER + i] = shade(np.asarray(p.colour), np.asarray(-shade.l[2]))
+                palette[ID_POSTER + i] = shade(np.asarray(p.colour), np.asarray(-shade.light[2]))
                 m = wall & (x >= p.x_min_m) & (x <= p.x_max_m) & (y >= p.bottom_m) & (y <= p.top_m)
                 ident[m] = ID_POSTER + i
     return Hits(t, ident, np.take(palette, ident, axis=0))
@@ -170,7 +170,7 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
         nx, nz = (dx[side] * ts - c.x) / c.r, (ts - c.z) / c.r
         seg = np.clip(np.searchsorted(c.bounds, ys, side="right") - 1, 0, len(c.bounds) - 1)
         hits.t[side], hits.ident[side] = ts, c.ident + seg
-        hits.rad[side] = shade(c.colours[seg], nx * shade.l[0] + nz * shade.l[2])
+        hits.rad[side] = shade(c.colours[seg], nx * shade.light[0] + nz * shade.light[2])
     if h > c.y1:
         yc, sign, part = c.y1, 1.0, PARTS - 1
     elif h < c.y0:
@@ -183,7 +183,7 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
     cap = (tc > 0.0) & ((xc - c.x) ** 2 + (tc - c.z) ** 2 <= c.r * c.r) & (tc < hits.t)
     if cap.any():
         hits.t[cap], hits.ident[cap] = tc[cap], c.ident + part
-        hits.rad[cap] = shade(c.cap, np.full(int(cap.sum()), sign * shade.l[1]))
+        hits.rad[cap] = shade(c.cap, np.full(int(cap.sum()), sign * shade.light[1]))
 
 
 def trace_box(dx: np.ndarray, dy: np.ndarray, h: float, b: Cuboid, shade: Shader,
@@ -204,7 +204,7 @@ def trace_box(dx: np.ndarray, dy: np.ndarray, h: float, b: Cuboid, shade: Shader
                     np.where(dy[hit] > 0, 2, 3), 4))
     normals = np.array([[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1]], float)
     hits.t[hit], hits.ident[hit] = tn, b.ident + face
-    hits.rad[hit] = shade(b.colour, normals[face] @ shade.l)
+    hits.rad[hit] = shade(b.colour, normals[face] @ shade.light)
 
 
 def trace(dx: np.ndarray, dy: np.ndarray, h: float, prim: Primitive, shade: Shader,
