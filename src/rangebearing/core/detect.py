@@ -17,17 +17,18 @@ the moments of the whole red and blue masks — one landmark at most.
 
 from __future__ import annotations
 
-from typing import List, Optional, Tuple
+from typing import List, Sequence, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
 from ..config import DetectionConfig
-from .blobs import find_blobs, mask_centroid, weighted_centroid
-from .color import Gains, apply_gains, hue_mask, soft_weights, to_hsv
+from .blobs import find_blobs, mask_centroid
+from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
+from .refine import refine_pairs
 from .types import XY, BandPair, BBox
 
 Region = Tuple[int, int, int, int]  # x0, y0, x1, y1 (exclusive), full-resolution pixels
@@ -52,9 +53,8 @@ def region_masks(
     roi = bgr[y0:y1, x0:x1]
     small = roi if s == 1 else cv2.resize(roi, ((x1 - x0) // s, (y1 - y0) // s), interpolation=cv2.INTER_AREA)
     hsv = to_hsv(apply_gains(small, gains))
-    red = majority_filter(hue_mask(hsv, cfg.red_hue, cfg.s_min, cfg.v_min), ksize)
-    blue = majority_filter(hue_mask(hsv, cfg.blue_hue, cfg.s_min, cfg.v_min), ksize)
-    return red, blue
+    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    return majority_filter(red, ksize), majority_filter(blue, ksize)
 
 
 def find_pairs(
@@ -72,42 +72,20 @@ def find_pairs(
     return pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
 
 
-def refine_pair(bgr: np.ndarray, pair: BandPair, cfg: DetectionConfig, gains: Gains) -> Optional[BandCentroids]:
-    """Sub-pixel band centroids from the unfiltered full-resolution pixels of one pair.
-
-    Each band's weights come from :func:`soft_weights` inside its blob's
-    bounding box grown by a margin that covers the downscaling and the
-    filter's erosion of the edges.
-    """
-    h, w = bgr.shape[:2]
-    margin = cfg.downscale + 1
-    x0, y0, bw, bh = pair.bbox_px
-    rx0, ry0 = max(0, x0 - margin), max(0, y0 - margin)
-    rx1, ry1 = min(w, x0 + bw + margin), min(h, y0 + bh + margin)
-    hsv = to_hsv(apply_gains(bgr[ry0:ry1, rx0:rx1], gains))
-    out = []
-    for blob, hues in ((pair.red, cfg.red_hue), (pair.blue, cfg.blue_hue)):
-        bx, by, bw_, bh_ = blob.bbox_px
-        ax0, ay0 = max(bx - margin, rx0) - rx0, max(by - margin, ry0) - ry0
-        ax1, ay1 = min(bx + bw_ + margin, rx1) - rx0, min(by + bh_ + margin, ry1) - ry0
-        w_x, w_y = soft_weights(hsv[ay0:ay1, ax0:ax1], hues, cfg.s_min, cfg.v_min)
-        cx, cy = weighted_centroid(w_x), weighted_centroid(w_y)
-        if cx is None or cy is None:
-            return None
-        out.append((rx0 + ax0 + cx[0], ry0 + ay0 + cy[1]))
-    width = 0.5 * (pair.red.width_px + pair.blue.width_px)
-    return BandCentroids(red_xy_px=out[0], blue_xy_px=out[1], width_px=width, bbox_px=pair.bbox_px)
-
-
 def detect_region(
     bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
 ) -> List[BandCentroids]:
     """Every landmark's band centroids inside one region (fast path)."""
+    return refine(bgr, find_pairs(bgr, region, cfg, gains, ksize, limits, geometry), cfg, gains)
+
+
+def refine(bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains) -> List[BandCentroids]:
+    """Sub-pixel centroids of every pair (one batch); pairs whose bands vanish are dropped."""
     found = []
-    for pair in find_pairs(bgr, region, cfg, gains, ksize, limits, geometry):
-        c = refine_pair(bgr, pair, cfg, gains)
+    for pair, c in zip(pairs, refine_pairs(bgr, pairs, cfg, gains)):
         if c is not None:
-            found.append(c)
+            width = 0.5 * (pair.red.width_px + pair.blue.width_px)
+            found.append(BandCentroids(red_xy_px=c[0], blue_xy_px=c[1], width_px=width, bbox_px=pair.bbox_px))
     return found
 
 

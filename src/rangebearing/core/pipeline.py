@@ -11,13 +11,14 @@ from __future__ import annotations
 
 from typing import Dict, List, Optional, Tuple
 
+import cv2
 import numpy as np
 
 from ..config import Config
 from ..errors import FrameError
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, Region, detect_paper, detect_region
+from .detect import BandCentroids, Region, detect_paper, find_pairs, refine
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .types import BBox, CameraIntrinsics, FrameResult, Landmark
@@ -121,12 +122,13 @@ class Pipeline:
                 tracked = True
             else:
                 if det.white_balance == "grey_world":
-                    self._gains = grey_world_gains(bgr[::8, ::8])
+                    self._gains = grey_world_gains(cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST))
                 regions = [full]
                 self._since_scan = 0
-            found = []
+            pairs = []
             for region in regions:
-                found.extend(detect_region(bgr, region, det, self._gains, ksize, self.limits, self.cfg.landmark))
+                pairs.extend(find_pairs(bgr, region, det, self._gains, ksize, self.limits, self.cfg.landmark))
+            found = refine(bgr, pairs, det, self._gains)
         landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)
         self._tracks = [lm.bbox_px for lm in landmarks] if self.track else []
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)

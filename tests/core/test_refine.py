@@ -1,0 +1,78 @@
+import numpy as np
+import pytest
+
+from rangebearing.config import DetectionConfig
+from rangebearing.core.color import to_hsv
+from rangebearing.core.refine import band_weights, refine_pairs, tile_centroids
+from rangebearing.core.types import BandPair, Blob
+
+CFG = DetectionConfig()
+RED, BLUE = np.array([40, 40, 200.0]), np.array([200, 60, 30.0])
+WHITE, BLACK = np.array([220, 220, 220.0]), np.array([15, 15, 15.0])
+
+
+def tiles(*images):
+    return np.stack([to_hsv(np.asarray(i, np.float64).round().astype(np.uint8)) for i in images])
+
+
+def test_horizontal_weights_ramp_with_saturation_and_respect_hue():
+    hsv = np.zeros((1, 1, 4, 3), np.uint8)
+    hsv[0, 0, :, 0] = (0, 0, 0, 60)  # last pixel green
+    hsv[0, 0, :, 1] = (40, 90, 200, 255)
+    hsv[0, 0, :, 2] = 200
+    w_x, w_y = band_weights(hsv, np.array([True]), CFG)
+    assert w_x.dtype == np.float32 and w_y.dtype == np.float32
+    assert w_x[0, 0].tolist() == pytest.approx([0.0, 0.5, 1.0, 0.0])
+    assert w_y[0, 0, 3] == 0.0
+
+
+def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
+    column = [WHITE, (RED + WHITE) / 2, RED, RED, RED, (RED + BLACK) / 2, BLACK]
+    _, w_y = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), np.array([True]), CFG)
+    w = w_y[0, :, 0]
+    assert w[0] == 0.0 and w[6] == 0.0
+    assert w[1] == pytest.approx(w[5], abs=0.03)  # symmetric, so the centroid stays at the band centre
+    _, y, ok = tile_centroids(w_y, w_y)
+    assert ok[0] and y[0] == pytest.approx(3.0, abs=0.02)
+
+
+def test_each_tile_uses_its_own_hue():
+    red_tile = np.full((3, 3, 3), RED)
+    blue_tile = np.full((3, 3, 3), BLUE)
+    w_x, w_y = band_weights(tiles(red_tile, blue_tile), np.array([True, False]), CFG)
+    assert w_x[0].min() > 0.9 and w_x[1].min() > 0.9
+    w_x, _ = band_weights(tiles(red_tile, blue_tile), np.array([False, True]), CFG)
+    assert w_x.max() == 0.0  # red pixels in a blue tile (and the reverse) weigh nothing
+
+
+def test_tile_centroids_by_hand_and_empty_tiles():
+    w = np.zeros((2, 4, 5), np.float32)
+    w[0, 1, 1] = w[0, 1, 2] = 1.0
+    w[0, 1, 3] = 0.5
+    x, y, ok = tile_centroids(w, w)
+    assert ok.tolist() == [True, False]
+    assert x[0] == pytest.approx((1 + 2 + 1.5) / 2.5) and y[0] == pytest.approx(1.0)
+
+
+def band(x, y, w, h):
+    return Blob(x + (w - 1) / 2, y + (h - 1) / 2, w * h, (x, y, w, h))
+
+
+@pytest.mark.parametrize("scale_rows", [6, 30])  # small bands at full resolution, tall ones at 1/f
+def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_rows):
+    img = np.full((200, 160, 3), 220, np.uint8)
+    h = scale_rows
+    img[20 : 20 + h, 40:80] = RED
+    img[100 : 100 + h, 42:82] = BLUE
+    pair = BandPair(red=band(40, 20, 40, h), blue=band(42, 100, 40, h))
+    ((rx, ry), (bx, by)) = refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0))[0]
+    assert (rx, ry) == pytest.approx((59.5, 20 + (h - 1) / 2), abs=0.05)
+    assert (bx, by) == pytest.approx((61.5, 100 + (h - 1) / 2), abs=0.05)
+
+
+def test_a_pair_whose_band_vanished_gives_none():
+    img = np.full((100, 100, 3), 220, np.uint8)
+    img[10:16, 10:40] = RED  # no blue anywhere
+    pair = BandPair(red=band(10, 10, 30, 6), blue=band(10, 50, 30, 6))
+    assert refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0)) == [None]
+    assert refine_pairs(img, [], CFG, (1.0, 1.0, 1.0)) == []
