@@ -391,7 +391,11 @@ def load_config(path: Union[str, Path, None] = None) -> Config:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         raise ConfigError([f"not valid YAML: {exc}".replace("\n", " ")], source) from None
-    return config_from_mapping(data, source)
+    cfg = config_from_mapping(data, source)
+    if cfg.source.path and not Path(cfg.source.path).is_absolute():  # relative to the file, not the cwd
+        resolved = str((Path(path).parent / cfg.source.path).resolve())
+        cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, path=resolved))
+    return cfg
 
 
 def config_to_mapping(cfg: Config) -> Dict[str, Any]:
