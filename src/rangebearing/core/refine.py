@@ -25,9 +25,7 @@ REFINE_BAND_PX = 12
 S_RAMP = 40  # saturation ramp half-width for the horizontal weights
 
 
-def band_weights(
-    hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig
-) -> Tuple[np.ndarray, np.ndarray]:
+def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
     """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W) float32 in [0, 1].
 
     Parameters

@@ -1,0 +1,174 @@
+"""The benchmark's frames: one camera per resolution, N landmarks drifting, ArUco markers beside them.
+
+Every contender sees the same frames. A scenario's frames are consecutive
+moments of one smooth motion whose period is the number of frames, so cycling
+through them (as the tracking contender does) never jumps. The markers the
+ArUco contender looks for are painted into the linear radiance before the
+sensor model, so they get the same blur and noise as the landmarks.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import List, Optional, Sequence, Tuple
+
+import cv2
+import numpy as np
+
+from rangebearing.config import Config
+from rangebearing.core.types import CameraIntrinsics
+from rangebearing.synth import Imaging, LandmarkPose, Scene, develop, landmark_bbox_px, render_linear
+
+HFOV_DEG = 53.5  # Pi Camera v1
+NEAR_M, FAR_M = 0.5, 1.2  # alternating landmark ranges
+WALL_M = 2.0  # beyond the farthest landmark
+EDGE_RAD = 0.06  # keeps the outermost landmarks wholly in view while they drift
+DRIFT_RAD = 0.010  # bearing amplitude of the drift (≈ 6 px at 640×480)
+DRIFT_RANGE_M = 0.02
+MARKER_SCALE = 1.3  # marker side / landmark image height
+NOISE = Imaging(blur_sigma_px=0.5, read_noise=0.004, shot_noise=0.0005)
+Marker = Tuple[int, int, int, int]  # x, y, side in px, id
+
+
+@dataclasses.dataclass
+class ScenarioFrames:
+    """One scenario: its camera and config, its frames and what each frame shows."""
+
+    width_px: int
+    height_px: int
+    n_landmarks: int
+    cfg: Config
+    frames: List[np.ndarray]
+    truth: List[Tuple[LandmarkPose, ...]]
+    markers: List[Marker]
+    marker_scale: float
+
+    @property
+    def label(self) -> str:
+        return f"{self.width_px}×{self.height_px}"
+
+
+def pi_camera(width_px: int, height_px: int) -> CameraIntrinsics:
+    """Square pixels, the Pi Camera v1 horizontal field of view, principal point at the centre."""
+    f = (width_px / 2.0) / math.tan(math.radians(HFOV_DEG / 2.0))
+    return CameraIntrinsics(width_px, height_px, f, f, (width_px - 1) / 2.0, (height_px - 1) / 2.0)
+
+
+def camera_config(base: Config, cam: CameraIntrinsics) -> Config:
+    """``base`` with this camera; the model's k (px·m, i.e. f·S) follows the focal length."""
+    k = cam.fy_px * base.landmark.band_spacing_m
+    return dataclasses.replace(base, camera=cam, model=dataclasses.replace(base.model, k_px_m=k))
+
+
+def poses(n: int, cam: CameraIntrinsics, phase: float) -> Tuple[LandmarkPose, ...]:
+    """``n`` landmarks at bearings spread evenly across the view, ranges alternating near/far.
+
+    ``phase`` (radians) is the moment of the drift: each landmark sways in
+    bearing and range on its own phase, a full period every 2π.
+    """
+    half = cam.hfov_rad / 2.0 - EDGE_RAD
+    out = []
+    for i in range(n):
+        centre = half * (1.0 - 2.0 * (i + 0.5) / n)  # left (positive) first
+        own = phase + 2.0 * math.pi * i / max(n, 1)
+        bearing = centre + DRIFT_RAD * math.sin(own)
+        rng_m = (NEAR_M if i % 2 == 0 else FAR_M) + DRIFT_RANGE_M * math.cos(own)
+        out.append(LandmarkPose(rng_m, bearing))
+    return tuple(out)
+
+
+def _occupied(scenes: Sequence[Scene], pad_px: int) -> np.ndarray:
+    """uint8 mask of every pixel a landmark or its robot covers in any of the scenes, padded."""
+    cam = scenes[0].camera
+    mask = np.zeros((cam.height_px, cam.width_px), np.uint8)
+    for scene in scenes:
+        for lm in scene.landmarks:
+            box = landmark_bbox_px(scene, lm, with_robot=True)
+            if box is None:
+                continue
+            u0, v0, u1, v1 = (int(round(c)) for c in box)
+            mask[max(0, v0 - pad_px): max(0, v1 + pad_px + 1), max(0, u0 - pad_px): max(0, u1 + pad_px + 1)] = 1
+    return mask
+
+
+def _first_free(occ: np.ndarray, side: int, step: int) -> Optional[Tuple[int, int]]:
+    """Top-left of the first ``side``×``side`` window (row by row) with nothing occupied."""
+    h, w = occ.shape
+    if side > min(h, w):
+        return None
+    integral = cv2.integral(occ)
+    ys = np.arange(0, h - side + 1, step)
+    xs = np.arange(0, w - side + 1, step)
+    y0, x0 = ys[:, None], xs[None, :]
+    sums = integral[y0 + side, x0 + side] - integral[y0, x0 + side] - integral[y0 + side, x0] + integral[y0, x0]
+    free = np.argwhere(sums == 0)
+    if free.size == 0:
+        return None
+    r, c = free[0]
+    return int(xs[c]), int(ys[r])
+
+
+def place_markers(scenes: Sequence[Scene], sizes_px: Sequence[float]) -> Tuple[List[Marker], float]:
+    """Marker squares in free space away from every landmark; shrinks all of them until they fit.
+
+    Returns the markers (ids 0, 1, …) and the scale they were drawn at (1 = as asked).
+    """
+    if not sizes_px:
+        return [], 1.0
+    cam = scenes[0].camera
+    step = max(1, cam.width_px // 160)
+    for scale in (1.0, 0.9, 0.8, 0.7, 0.6, 0.5):
+        occ = _occupied(scenes, pad_px=2 * step)
+        placed: List[Marker] = []
+        for ident, size in sorted(enumerate(sizes_px), key=lambda t: -t[1]):
+            side = max(12, int(round(size * scale)))
+            quiet = max(4, side // 6)  # one marker cell of wall around each marker
+            spot = _first_free(occ, side + 2 * quiet, step)
+            if spot is None:
+                break
+            x, y = spot
+            occ[y: y + side + 2 * quiet, x: x + side + 2 * quiet] = 1
+            placed.append((x + quiet, y + quiet, side, ident))
+        if len(placed) == len(sizes_px):
+            return sorted(placed, key=lambda m: m[3]), scale
+    raise RuntimeError(f"cannot fit {len(sizes_px)} markers into a {cam.width_px}×{cam.height_px} frame")
+
+
+def paint_markers(linear: np.ndarray, markers: Sequence[Marker], images: Sequence[np.ndarray]) -> None:
+    """Paint printed markers (black 5 %, white 85 % reflectance) into linear radiance, in place.
+
+    Each marker is lit like the surface it covers (its mean radiance over a grey of 0.78).
+    """
+    for (x, y, side, _), img in zip(markers, images):
+        patch = linear[y: y + side, x: x + side]
+        light = float(patch.mean()) / 0.78
+        albedo = 0.05 + 0.80 * (img.astype(np.float64) / 255.0)
+        patch[...] = (albedo * light)[:, :, None]
+
+
+def build_scenario(
+    base: Config, width_px: int, height_px: int, n: int, n_frames: int, seed: int, marker_images
+) -> ScenarioFrames:
+    """Render ``n_frames`` noisy frames of ``n`` drifting landmarks with one ArUco marker per landmark.
+
+    ``marker_images(ids_and_sides)`` returns the marker bitmaps (see :mod:`bench_aruco`).
+    """
+    cam = pi_camera(width_px, height_px)
+    cfg = camera_config(base, cam)
+    scenes = [
+        Scene(camera=cam, landmarks=poses(n, cam, 2.0 * math.pi * k / n_frames), wall_distance_m=WALL_M, imaging=NOISE)
+        for k in range(n_frames)
+    ]
+    heights = [cam.fy_px * base.landmark.height_m / lm.range_m for lm in poses(n, cam, 0.0)]
+    markers, scale = place_markers(scenes, [MARKER_SCALE * h for h in heights])
+    images = marker_images([(m[3], m[2]) for m in markers])
+    rng = np.random.default_rng(seed)
+    frames = []
+    for scene in scenes:
+        linear = render_linear(scene)
+        paint_markers(linear, markers, images)
+        frames.append(develop(linear, scene, rng))
+    return ScenarioFrames(
+        width_px, height_px, n, cfg, frames, [s.landmarks for s in scenes], markers, MARKER_SCALE * scale
+    )

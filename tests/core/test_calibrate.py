@@ -1,0 +1,54 @@
+import dataclasses
+import math
+
+import pytest
+
+from rangebearing.config import ModelConfig
+from rangebearing.core.calibrate import Sample, fit_model
+from rangebearing.errors import CalibrationError
+
+K, C = 35.2, 0.0125
+
+
+def pinhole_samples(ranges, bearings):
+    """Samples that follow range = K/(L cos θ) + C exactly."""
+    out = []
+    for i, (r, b) in enumerate(zip(ranges, bearings)):
+        L = K / ((r - C) * math.cos(b))
+        out.append(Sample(str(i), L, b, 0.0, r, b))
+    return out
+
+
+def test_pinhole_fit_recovers_k_and_c_and_the_envelope():
+    s = pinhole_samples([0.2, 0.4, 0.7, 1.1, 1.6], [0.1, -0.3, 0.0, 0.35, -0.2])
+    fit = fit_model(s, ModelConfig())
+    assert fit.model.k_px_m == pytest.approx(K, rel=1e-9)
+    assert fit.model.c_m == pytest.approx(C, abs=1e-9)
+    assert fit.range_err_pct_max < 1e-6
+    assert fit.model.envelope_range_m == (0.2, 1.6)
+    assert fit.model.envelope_bearing_rad == (-0.3, 0.35)
+
+
+def test_paper_fit_recovers_k_and_kh():
+    k, kh = 36.0, 0.0008
+    samples = []
+    for i, (L, px) in enumerate([(60, 40), (100, -80), (80, 10), (120, 150)]):
+        d_v, d_h = k / L, kh * px
+        r, b = math.hypot(d_v, d_h), math.atan2(d_h, d_v)
+        samples.append(Sample(str(i), L, b, px, r, b))
+    fit = fit_model(samples, dataclasses.replace(ModelConfig(), kind="paper"))
+    assert fit.model.k_px_m == pytest.approx(k)
+    assert fit.model.kh_m_per_px == pytest.approx(kh)
+
+
+@pytest.mark.parametrize(
+    "samples, message",
+    [
+        ([], "no landmark was detected"),
+        (pinhole_samples([0.3, 0.5], [0.0, 0.0]), "at least 4"),
+        (pinhole_samples([0.5, 0.5, 0.51, 0.5, 0.52], [0.0, 0.1, -0.1, 0.2, 0.0]), "one distance only"),
+    ],
+)
+def test_fit_refuses_data_that_cannot_support_it(samples, message):
+    with pytest.raises(CalibrationError, match=message):
+        fit_model(samples, ModelConfig())
