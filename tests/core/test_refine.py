@@ -39,7 +39,7 @@ def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
 def test_each_tile_uses_its_own_hue():
     red_tile = np.full((3, 3, 3), RED)
     blue_tile = np.full((3, 3, 3), BLUE)
-    w_x, w_y = band_weights(tiles(red_tile, blue_tile), np.array([True, False]), CFG)
+    w_x, _ = band_weights(tiles(red_tile, blue_tile), np.array([True, False]), CFG)
     assert w_x[0].min() > 0.9 and w_x[1].min() > 0.9
     w_x, _ = band_weights(tiles(red_tile, blue_tile), np.array([False, True]), CFG)
     assert w_x.max() == 0.0  # red pixels in a blue tile (and the reverse) weigh nothing
