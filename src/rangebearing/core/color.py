@@ -57,15 +57,21 @@ def to_hsv(bgr: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)
 
 
-def _hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
-    lo, hi = hue_ranges[0]
-    mask = cv2.inRange(h, lo, hi)
-    for lo, hi in hue_ranges[1:]:
-        mask = cv2.bitwise_or(mask, cv2.inRange(h, lo, hi))
-    return mask
+@functools.lru_cache(maxsize=16)
+def _hue_table(hue_ranges: Tuple[Tuple[int, int], ...]) -> np.ndarray:
+    table = np.zeros((256, 1), np.uint8)
+    for lo, hi in hue_ranges:
+        table[lo : hi + 1] = 255
+    return table
 
 
-def _sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int) -> np.ndarray:
+def hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
+    """0/255 mask of hue values inside any of the ranges (one table lookup)."""
+    return cv2.LUT(h, _hue_table(tuple(tuple(r) for r in hue_ranges)))
+
+
+def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int) -> np.ndarray:
+    """0/255 mask of S ≥ s_min and V ≥ v_min."""
     _, s_ok = cv2.threshold(s, s_min - 1, 255, cv2.THRESH_BINARY)
     _, v_ok = cv2.threshold(v, v_min - 1, 255, cv2.THRESH_BINARY)
     return cv2.bitwise_and(s_ok, v_ok)
@@ -77,7 +83,7 @@ def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> 
     Red wraps around hue 0, so it is given as two ranges, e.g. ``[(0, 10), (165, 179)]``.
     """
     h, s, v = cv2.split(hsv)
-    return cv2.bitwise_and(_hue_in(h, hue_ranges), _sv_gate(s, v, s_min, v_min))
+    return cv2.bitwise_and(hue_in(h, hue_ranges), sv_gate(s, v, s_min, v_min))
 
 
 def class_masks(
@@ -85,11 +91,12 @@ def class_masks(
 ) -> Tuple[np.ndarray, np.ndarray]:
     """The red and the blue :func:`hue_mask` of one image, sharing the channel split and S/V gate."""
     h, s, v = cv2.split(hsv)
-    sv = _sv_gate(s, v, s_min, v_min)
-    return cv2.bitwise_and(_hue_in(h, red_hue), sv), cv2.bitwise_and(_hue_in(h, blue_hue), sv)
+    sv = sv_gate(s, v, s_min, v_min)
+    return cv2.bitwise_and(hue_in(h, red_hue), sv), cv2.bitwise_and(hue_in(h, blue_hue), sv)
 
 
 @functools.lru_cache(maxsize=16)
 def ramp_table(lo: int, width: int) -> np.ndarray:
-    """float32 lookup table for ``cv2.LUT``: 0 up to ``lo``, rising linearly to 1 at ``lo + width``."""
-    return np.clip((np.arange(256, dtype=np.float32) - lo) / float(width), 0.0, 1.0).reshape(256, 1)
+    """uint8 lookup table for ``cv2.LUT``: 0 up to ``lo``, rising linearly to 255 at ``lo + width``."""
+    ramp = np.clip((np.arange(256, dtype=np.float64) - lo) / float(width), 0.0, 1.0)
+    return np.round(255.0 * ramp).astype(np.uint8).reshape(256, 1)

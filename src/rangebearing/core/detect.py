@@ -29,19 +29,29 @@ from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
 from .refine import refine_pairs
-from .types import XY, BandPair, BBox
+from .types import XY, BandPair, BBox, Blob
 
 Region = Tuple[int, int, int, int]  # x0, y0, x1, y1 (exclusive), full-resolution pixels
 
 
 @frozen
 class BandCentroids:
-    """Sub-pixel centroids of one landmark's bands and the region they came from."""
+    """One landmark's two bands: sub-pixel centroids, boxes and weights (full-resolution pixels)."""
 
     red_xy_px: XY
     blue_xy_px: XY
-    width_px: float
-    bbox_px: BBox
+    red_bbox_px: BBox
+    blue_bbox_px: BBox
+    red_mass_px: float
+    blue_mass_px: float
+
+    @property
+    def width_px(self) -> float:
+        return 0.5 * (self.red_bbox_px[2] + self.blue_bbox_px[2])
+
+    @property
+    def bbox_px(self) -> BBox:
+        return BandPair(Blob(0, 0, 0, self.red_bbox_px), Blob(0, 0, 0, self.blue_bbox_px)).bbox_px
 
 
 def region_masks(
@@ -82,10 +92,12 @@ def detect_region(
 def refine(bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains) -> List[BandCentroids]:
     """Sub-pixel centroids of every pair (one batch); pairs whose bands vanish are dropped."""
     found = []
-    for pair, c in zip(pairs, refine_pairs(bgr, pairs, cfg, gains)):
-        if c is not None:
-            width = 0.5 * (pair.red.width_px + pair.blue.width_px)
-            found.append(BandCentroids(red_xy_px=c[0], blue_xy_px=c[1], width_px=width, bbox_px=pair.bbox_px))
+    for pair, fix in zip(pairs, refine_pairs(bgr, pairs, cfg, gains)):
+        if fix is not None:
+            red, blue = fix
+            found.append(
+                BandCentroids(red.xy_px, blue.xy_px, pair.red.bbox_px, pair.blue.bbox_px, red.mass_px, blue.mass_px)
+            )
     return found
 
 
@@ -100,8 +112,6 @@ def detect_paper(bgr: np.ndarray, cfg: DetectionConfig) -> List[BandCentroids]:
     blue = mask_centroid(hue_mask(hsv, cfg.blue_hue, cfg.s_min, cfg.v_min))
     if red is None or blue is None or blue[1] <= red[1]:
         return []
-    bw = float(np.sqrt(red[2]))
-    x0 = int(min(red[0], blue[0]) - bw)
-    y0 = int(red[1] - bw)
-    bbox = (x0, y0, int(2 * bw), int(blue[1] - red[1] + 2 * bw))
-    return [BandCentroids(red_xy_px=(red[0], red[1]), blue_xy_px=(blue[0], blue[1]), width_px=bw, bbox_px=bbox)]
+    side = float(np.sqrt(red[2]))  # the paper has no band boxes: squares of the bands' areas
+    boxes = [(int(c[0] - side / 2), int(c[1] - side / 4), int(side), int(side / 2)) for c in (red, blue)]
+    return [BandCentroids((red[0], red[1]), (blue[0], blue[1]), boxes[0], boxes[1], red[2], blue[2])]

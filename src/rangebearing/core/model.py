@@ -37,7 +37,7 @@ def normalised(points_px: np.ndarray, cam: CameraIntrinsics) -> np.ndarray:
     """
     pts = np.asarray(points_px, dtype=np.float64).reshape(-1, 2)
     if not cam.has_distortion:
-        return np.column_stack(((pts[:, 0] - cam.cx_px) / cam.fx_px, (pts[:, 1] - cam.cy_px) / cam.fy_px))
+        return (pts - (cam.cx_px, cam.cy_px)) / (cam.fx_px, cam.fy_px)
     k = np.array([[cam.fx_px, 0.0, cam.cx_px], [0.0, cam.fy_px, cam.cy_px], [0.0, 0.0, 1.0]])
     crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-10)
     src, dist = pts.reshape(-1, 1, 2), np.asarray(cam.distortion, np.float64)
@@ -68,7 +68,11 @@ def pinhole_reading(
     red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig, geometry: LandmarkGeometry
 ) -> Tuple[float, float, float, float, float]:
     """``(range_m, bearing_rad, d_v_m, d_h_m, l_px)`` from band centroids with the pinhole model."""
-    (xr, yr), (xb, yb) = normalised(np.array([red_xy, blue_xy]), cam)
+    if cam.has_distortion:
+        (xr, yr), (xb, yb) = normalised(np.array([red_xy, blue_xy]), cam)
+    else:  # the common case, without numpy: this runs for every landmark of every frame
+        xr, yr = (red_xy[0] - cam.cx_px) / cam.fx_px, (red_xy[1] - cam.cy_px) / cam.fy_px
+        xb, yb = (blue_xy[0] - cam.cx_px) / cam.fx_px, (blue_xy[1] - cam.cy_px) / cam.fy_px
     l_n = math.hypot(xb - xr, yb - yr)
     l_px = l_n * cam.fy_px
     bearing = math.atan(-0.5 * (xr + xb))

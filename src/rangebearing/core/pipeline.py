@@ -18,10 +18,11 @@ from ..config import Config
 from ..errors import FrameError
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, Region, detect_paper, find_pairs, refine
+from .detect import BandCentroids, detect_paper, find_pairs, refine
 from .model import in_envelope, reading
 from .pairing import PairingLimits
-from .types import BBox, CameraIntrinsics, FrameResult, Landmark
+from .tracking import Track, step
+from .types import CameraIntrinsics, FrameResult, Landmark
 
 
 def check_frame(frame: object) -> np.ndarray:
@@ -35,29 +36,6 @@ def check_frame(frame: object) -> np.ndarray:
     if frame.shape[0] < 8 or frame.shape[1] < 8:
         raise FrameError(f"frame of {frame.shape[1]}×{frame.shape[0]} pixels is too small")
     return frame
-
-
-def grow(bbox: BBox, frame_w: int, frame_h: int, step: int) -> Region:
-    """A search window around a landmark's box: grown by half its size plus 8 px, clipped,
-    with width and height multiples of ``step`` (the downscale factor)."""
-    x, y, w, h = bbox
-    mx, my = w // 2 + 8, h // 2 + 8
-    x0, y0 = max(0, x - mx), max(0, y - my)
-    x1, y1 = min(frame_w, x + w + mx), min(frame_h, y + h + my)
-    x1 = x0 + max(step, (x1 - x0) // step * step)
-    y1 = y0 + max(step, (y1 - y0) // step * step)
-    return (x0, y0, min(x1, frame_w), min(y1, frame_h))
-
-
-def merge_regions(regions: List[Region]) -> List[Region]:
-    """Union overlapping windows so no pixel is searched twice in a frame."""
-    out: List[Region] = []
-    for r in sorted(regions):
-        if out and r[0] < out[-1][2] and r[1] < out[-1][3] and out[-1][1] < r[3]:
-            p = out.pop()
-            r = (min(p[0], r[0]), min(p[1], r[1]), max(p[2], r[2]), max(p[3], r[3]))
-        out.append(r)
-    return out
 
 
 class Pipeline:
@@ -82,7 +60,7 @@ class Pipeline:
 
     def reset(self) -> None:
         """Forget tracked landmarks; the next frame gets a full-frame search."""
-        self._tracks: List[BBox] = []
+        self._tracks: List[Track] = []
         self._since_scan = 0
         self._gains: Gains = UNIT_GAINS
 
@@ -114,23 +92,24 @@ class Pipeline:
         if det.method == "paper":
             found = detect_paper(bgr, det)
         else:
-            s = det.downscale
-            full = (0, 0, w // s * s, h // s * s)
             if self.track and self._tracks and self._since_scan < det.full_scan_every - 1:
-                regions = merge_regions([grow(b, w, h, s) for b in self._tracks])
-                self._since_scan += 1
+                self._tracks, lost = step(bgr, self._tracks, det, self._gains, self.cfg.landmark, self.limits)
+                # a lost landmark may be just outside its window: scan the whole frame next time
+                self._since_scan = det.full_scan_every if lost else self._since_scan + 1
+                found = [t.bands for t in self._tracks]
                 tracked = True
             else:
                 if det.white_balance == "grey_world":
-                    self._gains = grey_world_gains(cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST))
-                regions = [full]
+                    thumb = cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST)
+                    self._gains = grey_world_gains(thumb)
+                s = det.downscale
+                pairs = find_pairs(
+                    bgr, (0, 0, w // s * s, h // s * s), det, self._gains, ksize, self.limits, self.cfg.landmark
+                )
+                found = refine(bgr, pairs, det, self._gains)
+                self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
-            pairs = []
-            for region in regions:
-                pairs.extend(find_pairs(bgr, region, det, self._gains, ksize, self.limits, self.cfg.landmark))
-            found = refine(bgr, pairs, det, self._gains)
         landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)
-        self._tracks = [lm.bbox_px for lm in landmarks] if self.track else []
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
 
     def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:

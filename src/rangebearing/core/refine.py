@@ -14,19 +14,20 @@ from typing import List, Optional, Sequence, Tuple
 import cv2
 import numpy as np
 
+from .._compat import frozen
 from ..config import DetectionConfig
-from .color import CHROMA_FLOOR, Gains, apply_gains, class_masks, ramp_table, to_hsv
+from .color import CHROMA_FLOOR, Gains, apply_gains, hue_in, ramp_table, sv_gate, to_hsv
 from .types import XY, BandPair, BBox
 
 # Bands taller than this (full-resolution pixels) are measured at 1/f resolution,
 # so every band costs about the same whatever its range; a band still spans at
 # least REFINE_BAND_PX / 2 rows, ample for sub-pixel moments.
-REFINE_BAND_PX = 12
+REFINE_BAND_PX = 8
 S_RAMP = 40  # saturation ramp half-width for the horizontal weights
 
 
 def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
-    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W) float32 in [0, 1].
+    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W): ``w_x`` uint8 0–255, ``w_y`` float32 0–1.
 
     Parameters
     ----------
@@ -51,64 +52,94 @@ def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> T
     saturation would count a blue/black edge pixel as fully blue.
     """
     n, h, w = hsv.shape[:3]
-    flat = hsv.reshape(n * h, w, 3)
+    hue, sat, val = cv2.split(hsv.reshape(n * h, w, 3))
     v_gate = min(cfg.v_min, 10)
-    red, blue = class_masks(flat, cfg.red_hue, cfg.blue_hue, 1, v_gate)
-    red, blue = red.reshape(n, h, w), blue.reshape(n, h, w)
-    gate = np.where(is_red[:, None, None], red, blue) > 0
-    s, v = hsv[..., 1], hsv[..., 2]
-    w_x = cv2.LUT(s.reshape(n * h, w), ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)).reshape(n, h, w)
-    w_x *= gate
-    chroma = s.astype(np.float32) * v
-    core = gate & (s >= cfg.s_min)
-    count = core.sum(axis=(1, 2))
-    ref = np.where(count > 0, (chroma * core).sum(axis=(1, 2)) / np.maximum(count, 1), 0.0)
-    floor = CHROMA_FLOOR * ref
-    scale = np.where(ref > 0, 1.0 / np.maximum(ref - floor, 1e-6), 0.0).astype(np.float32)
-    chroma -= floor[:, None, None].astype(np.float32)
-    chroma *= scale[:, None, None]
-    w_y = np.clip(chroma, 0.0, 1.0, out=chroma)
-    w_y *= gate
-    return w_x, w_y
+    gate_rows = np.repeat(np.asarray(is_red, bool), h)[:, None]
+    gate = np.where(gate_rows, hue_in(hue, cfg.red_hue), hue_in(hue, cfg.blue_hue))
+    gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, v_gate))
+    w_x = cv2.bitwise_and(cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)), gate)
+    chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
+    core = cv2.bitwise_and(gate, sv_gate(sat, val, cfg.s_min, v_gate))
+    count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
+    total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
+    ref = (total / np.maximum(count, 1.0)).astype(np.float32)[:, None]
+    floor = np.float32(CHROMA_FLOOR) * ref
+    w_y = chroma.reshape(n, h * w).astype(np.float32)
+    w_y -= floor
+    w_y /= np.maximum(ref - floor, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
+    np.clip(w_y, 0.0, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
+    return w_x.reshape(n, h, w), w_y.reshape(n, h, w)
 
 
-def tile_centroids(w_x: np.ndarray, w_y: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-tile ``(x, y, ok)``: x from ``w_x``, y from ``w_y`` (first-order moments)."""
-    _, h, w = w_x.shape
-    m_x, m_y = w_x.sum(axis=(1, 2)), w_y.sum(axis=(1, 2))
-    ok = (m_x > 1e-6) & (m_y > 1e-6)
-    x = w_x.sum(axis=1) @ np.arange(w, dtype=np.float32) / np.where(ok, m_x, 1.0)
-    y = w_y.sum(axis=2) @ np.arange(h, dtype=np.float32) / np.where(ok, m_y, 1.0)
-    return x, y, ok
+def tile_centroids(w_x: np.ndarray, w_y: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per-tile ``(x, y, mass_x, ok)``: x from ``w_x``, y from ``w_y`` (first-order moments)."""
+    cols = w_x.sum(axis=1, dtype=np.float32)  # (N, W)
+    rows = w_y.sum(axis=2, dtype=np.float32)  # (N, H)
+    m_x, m_y = cols.sum(axis=1), rows.sum(axis=1)
+    ok = (m_x > 1e-3) & (m_y > 1e-3)
+    x = cols @ np.arange(cols.shape[1], dtype=np.float32) / np.maximum(m_x, 1e-3)
+    y = rows @ np.arange(rows.shape[1], dtype=np.float32) / np.maximum(m_y, 1e-3)
+    return x, y, m_x, ok
 
 
-def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: int) -> Tuple[int, int, int, int, int]:
+Margin = Tuple[int, int]  # grow a band's box by (x, y) pixels on each side
+
+
+@frozen
+class BandFix:
+    """One band measured on the unfiltered pixels.
+
+    ``mass_px`` is the band's weight (saturation ramp) in full-resolution
+    pixels: about its visible area, used to tell a tracked band from clutter.
+    """
+
+    xy_px: XY
+    mass_px: float
+
+
+def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: Margin) -> Tuple[int, int, int, int, int]:
     """``(x0, y0, x1, y1, f)``: the band's grown box, trimmed to a multiple of its scale ``f``."""
     h, w = shape[:2]
     bx, by, bw, bh = bbox
+    mx, my = margin
     f = max(1, bh // REFINE_BAND_PX)
-    x0, y0 = max(0, bx - margin), max(0, by - margin)
-    x1, y1 = min(w, bx + bw + margin), min(h, by + bh + margin)
-    return x0, y0, x0 + (x1 - x0) // f * f, y0 + (y1 - y0) // f * f, f
+    x0, y0 = max(0, bx - mx), max(0, by - my)
+    x1, y1 = min(w, bx + bw + mx), min(h, by + bh + my)
+    return x0, y0, x0 + max(f, (x1 - x0) // f * f), y0 + max(f, (y1 - y0) // f * f), f
 
 
-def refine_pairs(
-    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains
-) -> List[Optional[Tuple[XY, XY]]]:
-    """Sub-pixel ``(red_xy, blue_xy)`` for each pair in full-resolution pixels; ``None`` if a band vanished.
+def measure_bands(
+    bgr: np.ndarray,
+    boxes: Sequence[BBox],
+    is_red: Sequence[bool],
+    margins: Sequence[Margin],
+    cfg: DetectionConfig,
+    gains: Gains,
+) -> List[Optional[BandFix]]:
+    """Measure each band inside its box grown by its margin; ``None`` where nothing of its colour is left.
 
-    Each band is measured inside its blob's box grown by ``downscale + 1`` px,
-    which covers the downscaling and the majority filter's erosion.
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        The full-resolution frame.
+    boxes, is_red, margins : sequences of equal length
+        Each band's box (x, y, w, h) in full-resolution pixels, its colour, and
+        how far to grow the box on each side.
+
+    Returns
+    -------
+    list of BandFix or None
+        Centroids in full-resolution pixels (pixel centres at integers).
     """
-    if not pairs:
+    if not boxes:
         return []
-    margin = cfg.downscale + 1
-    regions = [_band_region(bgr.shape, b.bbox_px, margin) for p in pairs for b in (p.red, p.blue)]
+    regions = [_band_region(bgr.shape, b, m) for b, m in zip(boxes, margins)]
     crops = []
     for x0, y0, x1, y1, f in regions:
         roi = bgr[y0:y1, x0:x1]
-        if f > 1:
-            roi = cv2.resize(roi, ((x1 - x0) // f, (y1 - y0) // f), interpolation=cv2.INTER_AREA)
+        if f > 1:  # at exactly ½ bilinear is the 2×2 box average, and cheaper than INTER_AREA
+            interp = cv2.INTER_LINEAR if f == 2 else cv2.INTER_AREA
+            roi = cv2.resize(roi, ((x1 - x0) // f, (y1 - y0) // f), interpolation=interp)
         crops.append(roi)
     th = max(c.shape[0] for c in crops)
     tw = max(c.shape[1] for c in crops)
@@ -116,16 +147,31 @@ def refine_pairs(
     for tile, crop in zip(stack, crops):
         tile[: crop.shape[0], : crop.shape[1]] = crop
     hsv = to_hsv(apply_gains(stack.reshape(-1, tw, 3), gains)).reshape(stack.shape)
-    is_red = np.arange(len(crops)) % 2 == 0
-    x, y, ok = tile_centroids(*band_weights(hsv, is_red, cfg))
-    out: List[Optional[Tuple[XY, XY]]] = []
-    for i in range(len(pairs)):
-        if not (ok[2 * i] and ok[2 * i + 1]):
+    w_x, w_y = band_weights(hsv, np.asarray(is_red, bool), cfg)
+    x, y, mass, ok = tile_centroids(w_x, w_y)
+    mass /= 255.0  # w_x is 0–255
+    out: List[Optional[BandFix]] = []
+    for j, (x0, y0, _, _, f) in enumerate(regions):
+        if not ok[j]:
             out.append(None)
             continue
-        pts = []
-        for j in (2 * i, 2 * i + 1):
-            x0, y0, _, _, f = regions[j]
-            pts.append((x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5))
-        out.append((pts[0], pts[1]))
+        xy = (x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5)
+        out.append(BandFix(xy, float(mass[j]) * f * f))
+    return out
+
+
+def refine_pairs(
+    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains
+) -> List[Optional[Tuple[BandFix, BandFix]]]:
+    """Measure both bands of each pair (one batch); ``None`` for a pair whose band vanished.
+
+    Each band is measured inside its blob's box grown by ``downscale + 1`` px,
+    which covers the downscaling and the majority filter's erosion.
+    """
+    m = cfg.downscale + 1
+    boxes = [b.bbox_px for p in pairs for b in (p.red, p.blue)]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(pairs), [(m, m)] * len(boxes), cfg, gains)
+    out: List[Optional[Tuple[BandFix, BandFix]]] = []
+    for red, blue in zip(fixes[0::2], fixes[1::2]):
+        out.append(None if red is None or blue is None else (red, blue))
     return out

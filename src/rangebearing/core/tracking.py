@@ -1,0 +1,112 @@
+"""Tracking: between full-frame scans, measure last frame's landmarks where they should be.
+
+A track is a landmark's two bands from the previous frame and their image
+velocity. The next frame is searched only in each band's box, moved by that
+velocity and grown by a motion margin; no thresholding of the frame, no region
+search, no pairing, just the batched sub-pixel measurement. A track survives
+when both bands are found with about the same weight (area) as before and still
+in the landmark's geometry; otherwise it is lost and the caller scans the whole
+frame next.
+"""
+
+from __future__ import annotations
+
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+from .._compat import frozen
+from ..config import DetectionConfig
+from .color import Gains
+from .detect import BandCentroids
+from .pairing import PairingLimits
+from .refine import BandFix, Margin, measure_bands
+from .types import XY, BBox, LandmarkGeometry
+
+MASS_RATIO = (0.6, 1.6)  # a band's weight may change this much between frames
+
+
+@frozen
+class Track:
+    """A landmark followed from frame to frame."""
+
+    bands: BandCentroids
+    velocity_px: XY = (0.0, 0.0)
+
+
+def _moved(box: BBox, dx: float, dy: float) -> BBox:
+    return (round(box[0] + dx), round(box[1] + dy), box[2], box[3])
+
+
+def motion_margin(box: BBox) -> Margin:
+    """How far a band may stray from its predicted box between frames (pixels, x and y)."""
+    return (box[2] // 2 + 6, box[3] // 2 + 3)
+
+
+def search_boxes(track: Track) -> Tuple[BBox, BBox]:
+    """The red and blue boxes moved by the track's velocity."""
+    vx, vy = track.velocity_px
+    return _moved(track.bands.red_bbox_px, vx, vy), _moved(track.bands.blue_bbox_px, vx, vy)
+
+
+def plausible(old: BandCentroids, red: BandFix, blue: BandFix, geometry: LandmarkGeometry, lim: PairingLimits) -> bool:
+    """Both bands kept their weight and still stand one above the other at the landmark's spacing."""
+    lo, hi = MASS_RATIO
+    if not (lo * old.red_mass_px <= red.mass_px <= hi * old.red_mass_px):
+        return False
+    if not (lo * old.blue_mass_px <= blue.mass_px <= hi * old.blue_mass_px):
+        return False
+    w = old.width_px
+    dy = blue.xy_px[1] - red.xy_px[1]
+    expected = w * geometry.band_spacing_m / geometry.diameter_m
+    slack = lim.slack_px / expected
+    if not lim.spacing_lo - slack <= dy / expected <= lim.spacing_hi + slack:
+        return False
+    return abs(blue.xy_px[0] - red.xy_px[0]) <= lim.max_dx * w + lim.slack_px
+
+
+def advance(old: Track, red: BandFix, blue: BandFix) -> Track:
+    """The track after this frame: boxes follow the centroids, velocity is the last step."""
+    b = old.bands
+    rdx, rdy = red.xy_px[0] - b.red_xy_px[0], red.xy_px[1] - b.red_xy_px[1]
+    bdx, bdy = blue.xy_px[0] - b.blue_xy_px[0], blue.xy_px[1] - b.blue_xy_px[1]
+    bands = BandCentroids(
+        red.xy_px,
+        blue.xy_px,
+        _moved(b.red_bbox_px, rdx, rdy),
+        _moved(b.blue_bbox_px, bdx, bdy),
+        red.mass_px,
+        blue.mass_px,
+    )
+    return Track(bands, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
+
+
+def step(
+    bgr: np.ndarray,
+    tracks: Sequence[Track],
+    cfg: DetectionConfig,
+    gains: Gains,
+    geometry: LandmarkGeometry,
+    limits: PairingLimits,
+) -> Tuple[List[Track], bool]:
+    """Follow every track into this frame; returns the surviving tracks and whether any was lost."""
+    boxes: List[BBox] = []
+    for t in tracks:
+        boxes.extend(search_boxes(t))
+    fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), [motion_margin(b) for b in boxes], cfg, gains)
+    kept: List[Track] = []
+    lost = False
+    for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2]):
+        if red is None or blue is None or not plausible(t.bands, red, blue, geometry, limits):
+            lost = True
+            continue
+        new = advance(t, red, blue)
+        # two tracks that converged on one landmark: keep the first
+        if any(
+            abs(new.bands.red_xy_px[0] - k.bands.red_xy_px[0]) < 0.5 * new.bands.width_px
+            and abs(new.bands.red_xy_px[1] - k.bands.red_xy_px[1]) < 0.5 * new.bands.width_px
+            for k in kept
+        ):
+            continue
+        kept.append(new)
+    return kept, lost
