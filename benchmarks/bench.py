@@ -57,14 +57,14 @@ def _log(msg: str) -> None:
 def main(argv: Optional[List[str]] = None) -> int:
     args = parse_args(argv)
     _one_core()
-    import cv2
-
     import bench_aruco
+    import cv2
     from bench_daemon import daemon_check
     from bench_frames import build_scenario
     from bench_report import Run, label, machine_header, render
     from bench_stages import stage_breakdown
     from bench_timing import measure_scenario
+
     from rangebearing import Config
 
     cv2.setNumThreads(1)
@@ -82,7 +82,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     stage_frames = {}
     for w, h in plan["resolutions"]:
         for n in plan["counts"]:
-            sc = build_scenario(base, w, h, n, plan["frames"], seed=1000 * w + n, marker_images=bench_aruco.marker_images)
+            sc = build_scenario(base, w, h, n, plan["frames"], 1000 * w + n, bench_aruco.marker_images)
             _log(f"{sc.label}, {n} landmarks: timing …")
             run.figures[(sc.label, n)] = measure_scenario(sc, repeats, aruco)
             run.marker_scale[(sc.label, n)] = sc.marker_scale
@@ -97,7 +97,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         _log(f"stage breakdown failed: {run.stage_error}")
     _log(f"daemon keep-up at {DAEMON_FPS:.0f} fps for {plan['daemon_s']:.0f} s …")
     w, h = stage_res
-    clip = build_scenario(base, w, h, 1, plan["daemon_frames"], seed=7, marker_images=bench_aruco.marker_images)
+    clip = build_scenario(base, w, h, 1, plan["daemon_frames"], 7, bench_aruco.marker_images)
     run.daemon = daemon_check(clip.cfg, clip.frames, DAEMON_FPS, plan["daemon_s"])
     body = render(run)
     print(body)

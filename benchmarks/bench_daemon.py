@@ -81,7 +81,7 @@ def daemon_check(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration
     ``cfg`` carries the camera; tracking is whatever ``cfg.detection.tracking`` says (on by default).
     Readings go to a socket bound on 127.0.0.1, which counts them.
     """
-    limit = int(round(fps * duration_s))
+    limit = round(fps * duration_s)
     with tempfile.TemporaryDirectory(prefix="rb-bench-") as tmp, socket.socket(
         socket.AF_INET, socket.SOCK_DGRAM
     ) as rx:

@@ -87,7 +87,7 @@ def _occupied(scenes: Sequence[Scene], pad_px: int) -> np.ndarray:
             box = landmark_bbox_px(scene, lm, with_robot=True)
             if box is None:
                 continue
-            u0, v0, u1, v1 = (int(round(c)) for c in box)
+            u0, v0, u1, v1 = (round(c) for c in box)
             mask[max(0, v0 - pad_px): max(0, v1 + pad_px + 1), max(0, u0 - pad_px): max(0, u1 + pad_px + 1)] = 1
     return mask
 
@@ -122,7 +122,7 @@ def place_markers(scenes: Sequence[Scene], sizes_px: Sequence[float]) -> Tuple[L
         occ = _occupied(scenes, pad_px=2 * step)
         placed: List[Marker] = []
         for ident, size in sorted(enumerate(sizes_px), key=lambda t: -t[1]):
-            side = max(12, int(round(size * scale)))
+            side = max(12, round(size * scale))
             quiet = max(4, side // 6)  # one marker cell of wall around each marker
             spot = _first_free(occ, side + 2 * quiet, step)
             if spot is None:

@@ -15,10 +15,10 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
-
-import rangebearing
 from bench_daemon import DaemonFigures
 from bench_timing import Figures
+
+import rangebearing
 
 Key = Tuple[str, int]  # resolution label, landmarks in view
 Stages = Dict[int, Tuple[List[Tuple[str, float]], int]]  # landmarks -> (stage rows, found)
@@ -219,7 +219,8 @@ def render(run: Run) -> str:
         f"## Stage breakdown (full-frame scan, {run.stage_label})", stage_table(run),
         "## Daemon keep-up", daemon_table(run.daemon),
         "## Memory", f"Peak tracemalloc allocation per frame is in the tables above (numpy and OpenCV outputs; "
-        f"not OpenCV's internal buffers). Process max RSS at the end: {max_rss_mib():.0f} MiB.",
+        f"not OpenCV's internal buffers). Process max RSS at the end: {max_rss_mib():.0f} MiB (includes the "
+        "synthetic renderer, so far above what the daemon needs).",
         "## Targets", targets_table(run),
     ]) + "\n"
 

@@ -17,8 +17,8 @@ import tracemalloc
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
-
 from bench_frames import ScenarioFrames
+
 from rangebearing import Config, FrameResult, Pipeline
 from rangebearing._compat import frozen
 

@@ -68,7 +68,7 @@ def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_ro
     pair = BandPair(red=band(40, 20, 40, h), blue=band(42, 100, 40, h))
     red, blue = refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0))[0]
     (rx, ry), (bx, by) = red.xy_px, blue.xy_px
-    assert red.mass_px == pytest.approx(40 * h, rel=0.05)  # the weight is about the band's area
+    assert red.mass_px == pytest.approx(40 * h, rel=0.1)  # the weight is about the band area
     # y weights are linear in coverage: exact. x weights ramp with saturation, which is not
     # linear in coverage, so a band edge that half-fills a downscaled pixel shifts x a little.
     x_tol = 0.05 if h < 16 else 0.3

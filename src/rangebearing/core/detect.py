@@ -29,7 +29,7 @@ from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
 from .refine import refine_pairs
-from .types import XY, BandPair, BBox, Blob
+from .types import XY, BandPair, BBox, union
 
 Region = Tuple[int, int, int, int]  # x0, y0, x1, y1 (exclusive), full-resolution pixels
 
@@ -51,7 +51,7 @@ class BandCentroids:
 
     @property
     def bbox_px(self) -> BBox:
-        return BandPair(Blob(0, 0, 0, self.red_bbox_px), Blob(0, 0, 0, self.blue_bbox_px)).bbox_px
+        return union(self.red_bbox_px, self.blue_bbox_px)
 
 
 def region_masks(

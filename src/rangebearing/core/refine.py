@@ -46,7 +46,7 @@ def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> T
     across the cylinder does not pull the *horizontal* centroid.
 
     ``w_y`` weighs by chroma (max − min channel = S·V) relative to the band's
-    own mean chroma, above a floor of 15 % of it. Chroma is linear in the share
+    own mean chroma; pixels under 15 % of it weigh nothing. Chroma is linear in the share
     of a pixel the band covers whether the neighbour is the white body or the
     dark robot below, so the *vertical* centroid, and with it L, is unbiased;
     saturation would count a blue/black edge pixel as fully blue.
@@ -63,11 +63,10 @@ def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> T
     count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
     total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
     ref = (total / np.maximum(count, 1.0)).astype(np.float32)[:, None]
-    floor = np.float32(CHROMA_FLOOR) * ref
     w_y = chroma.reshape(n, h * w).astype(np.float32)
-    w_y -= floor
-    w_y /= np.maximum(ref - floor, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
-    np.clip(w_y, 0.0, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
+    w_y[w_y < np.float32(CHROMA_FLOOR) * ref] = 0.0  # the chroma noise of neutral pixels counts not at all
+    w_y /= np.maximum(ref, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
+    np.minimum(w_y, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
     return w_x.reshape(n, h, w), w_y.reshape(n, h, w)
 
 
@@ -103,7 +102,9 @@ def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: Margin) -> Tuple[in
     bx, by, bw, bh = bbox
     mx, my = margin
     f = max(1, bh // REFINE_BAND_PX)
-    x0, y0 = max(0, bx - mx), max(0, by - my)
+    # Downscaled pixels sit on a grid fixed to the frame, so a band gives the same
+    # weights whatever box it is measured in (tracking windows and full scans agree).
+    x0, y0 = max(0, bx - mx) // f * f, max(0, by - my) // f * f
     x1, y1 = min(w, bx + bw + mx), min(h, by + bh + my)
     return x0, y0, x0 + max(f, (x1 - x0) // f * f), y0 + max(f, (y1 - y0) // f * f), f
 

@@ -73,6 +73,13 @@ class LandmarkGeometry:
         return self.height_m - self.band_height_m
 
 
+def union(a: BBox, b: BBox) -> BBox:
+    """The smallest box holding both boxes."""
+    x0, y0 = min(a[0], b[0]), min(a[1], b[1])
+    x1, y1 = max(a[0] + a[2], b[0] + b[2]), max(a[1] + a[3], b[1] + b[3])
+    return (x0, y0, x1 - x0, y1 - y0)
+
+
 @frozen
 class Blob:
     """One connected region of a colour class, in full-resolution pixels."""
@@ -100,11 +107,7 @@ class BandPair:
 
     @property
     def bbox_px(self) -> BBox:
-        x0 = min(self.red.bbox_px[0], self.blue.bbox_px[0])
-        y0 = min(self.red.bbox_px[1], self.blue.bbox_px[1])
-        x1 = max(self.red.bbox_px[0] + self.red.bbox_px[2], self.blue.bbox_px[0] + self.blue.bbox_px[2])
-        y1 = max(self.red.bbox_px[1] + self.red.bbox_px[3], self.blue.bbox_px[1] + self.blue.bbox_px[3])
-        return (x0, y0, x1 - x0, y1 - y0)
+        return union(self.red.bbox_px, self.blue.bbox_px)
 
     @property
     def l_px(self) -> float:

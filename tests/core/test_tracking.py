@@ -1,0 +1,81 @@
+"""Tracking gives the same readings as full-frame search, and finds newcomers within the bound."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rangebearing import Pipeline, load_config
+from rangebearing.sources.recorded import iter_recorded
+from rangebearing.synth import Imaging, LandmarkPose, Scene, render
+
+ROOT = Path(__file__).resolve().parents[2]
+NOISE = Imaging(blur_sigma_px=0.5, read_noise=0.004, shot_noise=0.0005)
+# The stated tolerance between tracked and full-frame readings of the same frame.
+RANGE_TOL, BEARING_TOL_RAD = 0.003, math.radians(0.03)
+
+
+def moving_sequence(frames: int, newcomer_at: int = -1, seed: int = 0):
+    """Two landmarks drifting across the view; a third appears at ``newcomer_at``."""
+    rng = np.random.default_rng(seed)
+    for i in range(frames):
+        lms = [LandmarkPose(0.5 + 0.004 * i, 0.30 - 0.012 * i), LandmarkPose(1.1 - 0.006 * i, -0.25 + 0.008 * i)]
+        if 0 <= newcomer_at <= i:
+            lms.append(LandmarkPose(0.7, 0.02))
+        yield render(Scene(landmarks=tuple(lms), wall_distance_m=2.5, imaging=NOISE), rng)
+
+
+def assert_same_readings(frames):
+    cfg = load_config(None)
+    full, tracker = Pipeline(cfg, track=False), Pipeline(cfg, track=True)
+    tracked = 0
+    for img in frames:
+        a, b = full.process(img), tracker.process(img)
+        tracked += b.tracked
+        assert len(a.landmarks) == len(b.landmarks)
+        for x, y in zip(a.landmarks, b.landmarks):
+            assert y.range_m == pytest.approx(x.range_m, rel=RANGE_TOL)
+            assert y.bearing_rad == pytest.approx(x.bearing_rad, abs=BEARING_TOL_RAD)
+    return tracked
+
+
+def test_tracking_matches_full_search_on_the_bundled_clip():
+    frames = [img for _, img in iter_recorded(ROOT / "samples" / "clip")]
+    assert assert_same_readings(frames) >= len(frames) * 3 // 4
+
+
+def test_tracking_matches_full_search_on_a_moving_sequence():
+    assert assert_same_readings(list(moving_sequence(24))) >= 18
+
+
+@pytest.mark.parametrize("appears", range(3, 3 + 8))  # every phase of the full-scan cycle
+def test_a_newcomer_is_found_within_full_scan_every_frames(appears):
+    cfg = load_config(None)
+    bound = cfg.detection.full_scan_every
+    pipe = Pipeline(cfg, track=True)
+    found_at = None
+    for i, img in enumerate(moving_sequence(appears + bound + 1, newcomer_at=appears)):
+        n = len(pipe.process(img).landmarks)
+        if i >= appears and n == 3:
+            found_at = i
+            break
+        assert n == 2  # never more than are there
+    assert found_at is not None and found_at - appears < bound
+
+
+def test_a_lost_landmark_triggers_a_full_scan_on_the_next_frame():
+    cfg = dataclasses.replace(load_config(None))
+    pipe = Pipeline(cfg, track=True)
+    still = Scene(landmarks=(LandmarkPose(0.6, 0.25),), wall_distance_m=2.5)
+    jumped = Scene(landmarks=(LandmarkPose(0.6, -0.25),), wall_distance_m=2.5)
+    pipe.process(render(still))
+    assert pipe.process(render(still)).tracked
+    lost = pipe.process(render(jumped))  # out of its window: tracked frame, nothing found
+    assert lost.tracked and lost.landmarks == ()
+    again = pipe.process(render(jumped))
+    assert not again.tracked and len(again.landmarks) == 1
+    assert again.landmarks[0].bearing_rad == pytest.approx(-0.25, abs=0.01)
