@@ -20,15 +20,15 @@ def test_horizontal_weights_ramp_with_saturation_and_respect_hue():
     hsv[0, 0, :, 0] = (0, 0, 0, 60)  # last pixel green
     hsv[0, 0, :, 1] = (40, 90, 200, 255)
     hsv[0, 0, :, 2] = 200
-    w_x, w_y = band_weights(hsv, np.array([True]), CFG)
-    assert w_x.dtype == np.uint8 and w_y.dtype == np.float32
+    w_x, w_y = band_weights(hsv, 1, CFG)
+    assert w_x.dtype == np.uint8 and w_y.dtype == np.uint8
     assert (w_x[0, 0] / 255).tolist() == pytest.approx([0.0, 0.5, 1.0, 0.0], abs=0.01)
     assert w_y[0, 0, 3] == 0.0
 
 
 def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
     column = [WHITE, (RED + WHITE) / 2, RED, RED, RED, (RED + BLACK) / 2, BLACK]
-    _, w_y = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), np.array([True]), CFG)
+    _, w_y = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), 1, CFG)
     w = w_y[0, :, 0]
     assert w[0] == 0.0 and w[6] == 0.0
     assert w[1] == pytest.approx(w[5], abs=0.03)  # symmetric, so the centroid stays at the band centre
@@ -39,10 +39,10 @@ def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
 def test_each_tile_uses_its_own_hue():
     red_tile = np.full((3, 3, 3), RED)
     blue_tile = np.full((3, 3, 3), BLUE)
-    w_x, _ = band_weights(tiles(red_tile, blue_tile), np.array([True, False]), CFG)
+    w_x, _ = band_weights(tiles(red_tile, blue_tile), 1, CFG)
     assert w_x[0].min() > 230 and w_x[1].min() > 230
-    w_x, _ = band_weights(tiles(red_tile, blue_tile), np.array([False, True]), CFG)
-    assert w_x.max() == 0.0  # red pixels in a blue tile (and the reverse) weigh nothing
+    w_x, _ = band_weights(tiles(blue_tile, red_tile), 1, CFG)
+    assert w_x.max() == 0  # blue pixels in a red tile (and the reverse) weigh nothing
 
 
 def test_tile_centroids_by_hand_and_empty_tiles():

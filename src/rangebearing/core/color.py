@@ -16,7 +16,7 @@ Gains = Tuple[float, float, float]
 HueRanges = Sequence[Tuple[int, int]]
 
 UNIT_GAINS: Gains = (1.0, 1.0, 1.0)
-CHROMA_FLOOR = 0.15  # share of a band's chroma below which a pixel does not count
+CHROMA_FLOOR = 12  # chroma (max − min channel, 0–255) below which a pixel does not count
 
 
 def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
@@ -58,7 +58,8 @@ def to_hsv(bgr: np.ndarray) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=16)
-def _hue_table(hue_ranges: Tuple[Tuple[int, int], ...]) -> np.ndarray:
+def hue_table(hue_ranges: Tuple[Tuple[int, int], ...]) -> np.ndarray:
+    """uint8 lookup table for ``cv2.LUT``: 255 for hues inside any range, else 0."""
     table = np.zeros((256, 1), np.uint8)
     for lo, hi in hue_ranges:
         table[lo : hi + 1] = 255
@@ -67,7 +68,7 @@ def _hue_table(hue_ranges: Tuple[Tuple[int, int], ...]) -> np.ndarray:
 
 def hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
     """0/255 mask of hue values inside any of the ranges (one table lookup)."""
-    return cv2.LUT(h, _hue_table(tuple(tuple(r) for r in hue_ranges)))
+    return cv2.LUT(h, hue_table(tuple(map(tuple, hue_ranges))))
 
 
 def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int) -> np.ndarray:

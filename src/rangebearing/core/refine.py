@@ -16,7 +16,7 @@ import numpy as np
 
 from .._compat import frozen
 from ..config import DetectionConfig
-from .color import CHROMA_FLOOR, Gains, apply_gains, hue_in, ramp_table, sv_gate, to_hsv
+from .color import CHROMA_FLOOR, Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
 from .types import XY, BandPair, BBox
 
 # Bands taller than this (full-resolution pixels) are measured at 1/f resolution,
@@ -26,15 +26,15 @@ REFINE_BAND_PX = 8
 S_RAMP = 40  # saturation ramp half-width for the horizontal weights
 
 
-def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
-    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W): ``w_x`` uint8 0–255, ``w_y`` float32 0–1.
+def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
+    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W) uint8.
 
     Parameters
     ----------
     hsv : (N, H, W, 3) uint8
         HSV tiles, one band each.
-    is_red : (N,) bool
-        Which tiles hold a red band (the others blue).
+    n_red : int
+        The first ``n_red`` tiles hold red bands, the rest blue ones.
 
     Notes
     -----
@@ -42,31 +42,27 @@ def band_weights(hsv: np.ndarray, is_red: np.ndarray, cfg: DetectionConfig) -> T
     than 10.
 
     ``w_x`` weighs by saturation on a linear ramp from ``s_min − 40`` (0) to
-    ``s_min + 40`` (1). Saturation does not depend on brightness, so shading
+    ``s_min + 40`` (255). Saturation does not depend on brightness, so shading
     across the cylinder does not pull the *horizontal* centroid.
 
-    ``w_y`` weighs by chroma (max − min channel = S·V) relative to the band's
-    own mean chroma; pixels under 15 % of it weigh nothing. Chroma is linear in the share
-    of a pixel the band covers whether the neighbour is the white body or the
-    dark robot below, so the *vertical* centroid, and with it L, is unbiased;
-    saturation would count a blue/black edge pixel as fully blue.
+    ``w_y`` weighs by chroma (max − min channel = S·V/255); pixels under
+    ``CHROMA_FLOOR`` weigh nothing. Chroma is linear in
+    the share of a pixel the band covers whether the neighbour is the white body
+    or the dark robot below, so the *vertical* centroid, and with it L, is
+    unbiased; saturation would count a blue/black edge pixel as fully blue.
     """
     n, h, w = hsv.shape[:3]
     hue, sat, val = cv2.split(hsv.reshape(n * h, w, 3))
-    v_gate = min(cfg.v_min, 10)
-    gate_rows = np.repeat(np.asarray(is_red, bool), h)[:, None]
-    gate = np.where(gate_rows, hue_in(hue, cfg.red_hue), hue_in(hue, cfg.blue_hue))
-    gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, v_gate))
+    gate = np.empty_like(hue)
+    split = n_red * h
+    if split:
+        cv2.LUT(hue[:split], hue_table(cfg.red_hue), dst=gate[:split])
+    if split < n * h:
+        cv2.LUT(hue[split:], hue_table(cfg.blue_hue), dst=gate[split:])
+    gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, min(cfg.v_min, 10)))
     w_x = cv2.bitwise_and(cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)), gate)
     chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
-    core = cv2.bitwise_and(gate, sv_gate(sat, val, cfg.s_min, v_gate))
-    count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
-    total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
-    ref = (total / np.maximum(count, 1.0)).astype(np.float32)[:, None]
-    w_y = chroma.reshape(n, h * w).astype(np.float32)
-    w_y[w_y < np.float32(CHROMA_FLOOR) * ref] = 0.0  # the chroma noise of neutral pixels counts not at all
-    w_y /= np.maximum(ref, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
-    np.minimum(w_y, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
+    _, w_y = cv2.threshold(chroma, CHROMA_FLOOR - 1, 0, cv2.THRESH_TOZERO)  # neutral pixels' chroma noise: 0
     return w_x.reshape(n, h, w), w_y.reshape(n, h, w)
 
 
@@ -134,7 +130,8 @@ def measure_bands(
     """
     if not boxes:
         return []
-    regions = [_band_region(bgr.shape, b, m) for b, m in zip(boxes, margins)]
+    order = [k for k, red in enumerate(is_red) if red] + [k for k, red in enumerate(is_red) if not red]
+    regions = [_band_region(bgr.shape, boxes[k], margins[k]) for k in order]
     crops = []
     for x0, y0, x1, y1, f in regions:
         roi = bgr[y0:y1, x0:x1]
@@ -148,16 +145,12 @@ def measure_bands(
     for tile, crop in zip(stack, crops):
         tile[: crop.shape[0], : crop.shape[1]] = crop
     hsv = to_hsv(apply_gains(stack.reshape(-1, tw, 3), gains)).reshape(stack.shape)
-    w_x, w_y = band_weights(hsv, np.asarray(is_red, bool), cfg)
-    x, y, mass, ok = tile_centroids(w_x, w_y)
-    mass /= 255.0  # w_x is 0–255
-    out: List[Optional[BandFix]] = []
-    for j, (x0, y0, _, _, f) in enumerate(regions):
-        if not ok[j]:
-            out.append(None)
-            continue
-        xy = (x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5)
-        out.append(BandFix(xy, float(mass[j]) * f * f))
+    x, y, mass, ok = tile_centroids(*band_weights(hsv, sum(1 for r in is_red if r), cfg))
+    out: List[Optional[BandFix]] = [None] * len(boxes)
+    for j, (k, (x0, y0, _, _, f)) in enumerate(zip(order, regions)):
+        if ok[j]:
+            xy = (x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5)
+            out[k] = BandFix(xy, float(mass[j]) * f * f / 255.0)  # w_x is 0–255
     return out
 
 
