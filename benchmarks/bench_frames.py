@@ -56,7 +56,10 @@ def pi_camera(width_px: int, height_px: int) -> CameraIntrinsics:
 
 
 def camera_config(base: Config, cam: CameraIntrinsics) -> Config:
-    """``base`` with this camera; the model's k (px·m, i.e. f·S) follows the focal length."""
+    """``base`` with this camera; the paper model's k (px·m, i.e. f·S) follows the focal length.
+
+    The default pinhole model needs nothing: it is in normalised units.
+    """
     k = cam.fy_px * base.landmark.band_spacing_m
     return dataclasses.replace(base, camera=cam, model=dataclasses.replace(base.model, k_px_m=k))
 

@@ -37,8 +37,8 @@ def calibrated(tmp_path_factory):
 
 def test_calibrate_writes_a_config_that_loads(calibrated, capsys):
     cfg = load_config(calibrated)
-    # k = f·H for the renderer's camera (634 px × 0.055 m); c ≈ (π/4)·radius
-    assert cfg.model.k_px_m == pytest.approx(634 * 0.055, rel=0.03)
+    # the fitted band spacing is the landmark's 55 mm; c ≈ (π/4)·radius
+    assert cfg.model.spacing_m == pytest.approx(0.055, rel=0.03)
     assert 0.0 < cfg.model.c_m < 0.03
     lo, hi = cfg.model.envelope_range_m
     assert lo < 0.3 and hi > 1.5

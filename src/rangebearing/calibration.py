@@ -30,18 +30,20 @@ def collect_samples(frames: Frames, cfg: Config) -> List[Sample]:
     Frames without truth rows or without an image are skipped.
     """
     pipe = Pipeline(cfg, track=False)
-    cam = cfg.camera
     samples = []
     for name, image, rows in frames:
         if image is None or not rows:
             continue
+        h, w = image.shape[:2]
+        cam = cfg.camera if (cfg.camera.width_px, cfg.camera.height_px) == (w, h) else cfg.camera.scaled(w, h)
         matches, _ = match_frame(name, pipe.process(image).landmarks, rows, CALIBRATION_GAP_RAD)
         for m in matches:
             if m.found is None:
                 continue
             lm = m.found
             px_left = cam.cx_px - 0.5 * (lm.red_xy_px[0] + lm.blue_xy_px[0])
-            samples.append(Sample(name, lm.l_px, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad))
+            l_norm = lm.l_px / cam.fy_px
+            samples.append(Sample(name, lm.l_px, l_norm, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad))
     return samples
 
 

@@ -47,13 +47,16 @@ class DetectionConfig:
 class ModelConfig:
     """Range and bearing from band centroids.
 
-    ``pinhole``: d_v = k/L + c, bearing = atan(px/f) after undistortion.
-    ``paper``: d_v = k/L, d_h = kh·px, θ = atan(d_h/d_v), d = d_v/cos θ.
+    ``pinhole``: range = f·spacing/(L·cos θ) + c, bearing = atan(x/f) after
+    undistortion; in normalised image units, so it holds at any resolution.
+    ``paper``: d_v = k/L, d_h = kh·px, θ = atan(d_h/d_v), d = d_v/cos θ, with
+    k and kh in the pixels of the resolution they were fitted at.
     """
 
     kind: str = "pinhole"
-    k_px_m: float = 34.87
+    spacing_m: float = 0.055
     c_m: float = 0.0137
+    k_px_m: float = 35.0
     kh_m_per_px: float = 0.00079
     cylinder_correction: bool = True
     envelope_range_m: Tuple[float, float] = (0.15, 2.0)
@@ -272,8 +275,9 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, Check]]] = {
         ModelConfig,
         {
             "kind": _choice(*MODELS),
-            "k_px_m": _positive(),
+            "spacing_m": _positive(),
             "c_m": _number(-0.5, 0.5),
+            "k_px_m": _positive(),
             "kh_m_per_px": _positive(),
             "cylinder_correction": _bool,
             "envelope_range_m": _pair(0, 100),

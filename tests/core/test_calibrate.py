@@ -7,22 +7,22 @@ from rangebearing.config import ModelConfig
 from rangebearing.core.calibrate import Sample, fit_model
 from rangebearing.errors import CalibrationError
 
-K, C = 35.2, 0.0125
+S, C, F = 0.0552, 0.0125, 634.0
 
 
 def pinhole_samples(ranges, bearings):
-    """Samples that follow range = K/(L cos θ) + C exactly."""
+    """Samples that follow range = S/(L_n cos θ) + C exactly."""
     out = []
     for i, (r, b) in enumerate(zip(ranges, bearings)):
-        L = K / ((r - C) * math.cos(b))
-        out.append(Sample(str(i), L, b, 0.0, r, b))
+        l_norm = S / ((r - C) * math.cos(b))
+        out.append(Sample(str(i), l_norm * F, l_norm, b, 0.0, r, b))
     return out
 
 
-def test_pinhole_fit_recovers_k_and_c_and_the_envelope():
+def test_pinhole_fit_recovers_spacing_and_c_and_the_envelope():
     s = pinhole_samples([0.2, 0.4, 0.7, 1.1, 1.6], [0.1, -0.3, 0.0, 0.35, -0.2])
     fit = fit_model(s, ModelConfig())
-    assert fit.model.k_px_m == pytest.approx(K, rel=1e-9)
+    assert fit.model.spacing_m == pytest.approx(S, rel=1e-9)
     assert fit.model.c_m == pytest.approx(C, abs=1e-9)
     assert fit.range_err_pct_max < 1e-6
     assert fit.model.envelope_range_m == (0.2, 1.6)
@@ -35,7 +35,7 @@ def test_paper_fit_recovers_k_and_kh():
     for i, (L, px) in enumerate([(60, 40), (100, -80), (80, 10), (120, 150)]):
         d_v, d_h = k / L, kh * px
         r, b = math.hypot(d_v, d_h), math.atan2(d_h, d_v)
-        samples.append(Sample(str(i), L, b, px, r, b))
+        samples.append(Sample(str(i), L, L / F, b, px, r, b))
     fit = fit_model(samples, dataclasses.replace(ModelConfig(), kind="paper"))
     assert fit.model.k_px_m == pytest.approx(k)
     assert fit.model.kh_m_per_px == pytest.approx(kh)

@@ -84,7 +84,7 @@ def test_pinhole_model_by_hand():
     # on the axis: range = k/L + c
     r, b = centroids(0, 100)
     rng, _th, d_v, d_h, _L = pinhole_reading(r, b, CAM, PIN, GEO)
-    assert rng == pytest.approx(PIN.k_px_m / 100 + PIN.c_m)
+    assert rng == pytest.approx(PIN.spacing_m * CAM.fy_px / 100 + PIN.c_m)
     assert d_h == pytest.approx(0.0) and d_v == pytest.approx(rng)
 
 

@@ -37,7 +37,7 @@ def print_fit(fit: Fit) -> None:
     if m.kind == "paper":
         print(f"model paper: d_v = {m.k_px_m * 100:.1f} px·cm / L,  d_h = {m.kh_m_per_px * 100:.5f} cm/px · px")
     else:
-        print(f"model pinhole: range = {m.k_px_m:.4f} px·m / (L·cos θ) + {m.c_m * 1000:.2f} mm")
+        print(f"model pinhole: range = f·{m.spacing_m * 1000:.2f} mm / (L·cos θ) + {m.c_m * 1000:.2f} mm")
     print(f"{'frame':>16} {'true m':>8} {'fit m':>8} {'err %':>7} {'true °':>8} {'err °':>7}")
     for r in fit.residuals:
         print(

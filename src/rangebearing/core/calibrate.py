@@ -24,7 +24,8 @@ class Sample:
     """One detected landmark with its true position."""
 
     frame: str
-    l_px: float
+    l_px: float  # band centroid distance in the frame's pixels (the paper's L)
+    l_norm: float  # the same in normalised image units (L / f, after undistortion)
     bearing_meas_rad: float
     px_left: float  # horizontal offset of the centroids from the principal point, + left
     range_m: float
@@ -82,7 +83,7 @@ def _envelope(samples: Sequence[Sample]) -> Tuple[Tuple[float, float], Tuple[flo
 def fit_model(samples: Sequence[Sample], base: ModelConfig) -> Fit:
     """Fit ``base.kind``'s coefficients and the validity envelope.
 
-    pinhole: ``range = k/(L·cos θ) + c`` by linear least squares in (k, c).
+    pinhole: ``range = S/(L_n·cos θ) + c`` by linear least squares in (S, c).
     paper:   ``d_v = k/L`` and ``d_h = k_h·px`` by least squares through the origin.
     """
     check_samples(samples)
@@ -103,15 +104,17 @@ def fit_model(samples: Sequence[Sample], base: ModelConfig) -> Fit:
         f_th = np.arctan2(fh, fv)
         f_rng = fv / np.cos(f_th)
     else:
-        x = 1.0 / (L * np.cos(th_m))
+        x = 1.0 / (np.array([s.l_norm for s in samples]) * np.cos(th_m))
         a = np.column_stack((x, np.ones_like(x)))
-        (k, c), *_ = np.linalg.lstsq(a, rng, rcond=None)
-        if k <= 0:
-            raise CalibrationError("fitted k is not positive: the measured band spacing does not shrink with range")
+        (spacing, c), *_ = np.linalg.lstsq(a, rng, rcond=None)
+        if spacing <= 0:
+            raise CalibrationError(
+                "fitted spacing is not positive: the band spacing in the image does not shrink with range"
+            )
         model = dataclasses.replace(
-            base, k_px_m=float(k), c_m=float(c), envelope_range_m=env_r, envelope_bearing_rad=env_b
+            base, spacing_m=float(spacing), c_m=float(c), envelope_range_m=env_r, envelope_bearing_rad=env_b
         )
-        f_rng = k * x + c
+        f_rng = spacing * x + c
         f_th = th_m
     residuals = tuple(
         Residual(s.frame, s.range_m, float(fr), s.bearing_rad, float(fb)) for s, fr, fb in zip(samples, f_rng, f_th)

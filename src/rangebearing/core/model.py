@@ -1,6 +1,6 @@
 """Range and bearing from the two band centroids: the paper's model and a pinhole model.
 
-Paper (Balanji & Turgut), equations 1–5::
+Paper (Balanji & Turgut), equations 1–5, in the pixels of the calibration resolution::
 
     d_v = k / L            (k = 3500 px·cm = 35 px·m for d_v in 28–72 cm)
     d_h = k_h · px         (px: horizontal pixel offset from the image centre)
@@ -14,7 +14,7 @@ of range. The band centroids lie on the cylinder's *near* surface, about
 c ≈ (π/4)·radius closer along the line of sight than the axis, so::
 
     θ = atan(−x_n)              (x_n undistorted normalised column; + is left)
-    d = k / (L_n·f·cos θ) + c   (range to the axis, k = f·H)
+    d = S / (L_n·cos θ) + c     (range to the axis; L_n = L/f, S = band spacing 0.055 m)
     d_v = d·cos θ,  d_h = d·sin θ
 """
 
@@ -76,7 +76,7 @@ def pinhole_reading(
     l_n = math.hypot(xb - xr, yb - yr)
     l_px = l_n * cam.fy_px
     bearing = math.atan(-0.5 * (xr + xb))
-    rng = model.k_px_m / (l_px * math.cos(bearing)) + model.c_m
+    rng = model.spacing_m / (l_n * math.cos(bearing)) + model.c_m
     if model.cylinder_correction:
         bearing = axis_bearing(bearing, rng, geometry.radius_m)
     return rng, bearing, rng * math.cos(bearing), rng * math.sin(bearing), l_px
