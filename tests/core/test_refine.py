@@ -3,7 +3,7 @@ import pytest
 
 from rangebearing.config import DetectionConfig
 from rangebearing.core.color import to_hsv
-from rangebearing.core.refine import band_weights, refine_pairs, tile_centroids
+from rangebearing.core.refine import band_weights, measure_bands, refine_pairs, tile_centroids
 from rangebearing.core.types import BandPair, Blob
 
 CFG = DetectionConfig()
@@ -82,3 +82,14 @@ def test_a_pair_whose_band_vanished_gives_none():
     pair = BandPair(red=band(10, 10, 30, 6), blue=band(10, 50, 30, 6))
     assert refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0)) == [None]
     assert refine_pairs(img, [], CFG, (1.0, 1.0, 1.0)) == []
+
+
+def test_a_neighbouring_band_inside_the_window_does_not_pull_the_centroid():
+    img = np.full((60, 120, 3), 220, np.uint8)
+    img[20:30, 20:50] = RED
+    img[20:30, 56:86] = RED  # another landmark's red band, 6 px to the right
+    alone = band(20, 20, 30, 10)
+    other = band(56, 20, 30, 10)
+    fixes = measure_bands(img, [alone.bbox_px, other.bbox_px], [True, True], [(12, 4), (12, 4)], CFG, (1.0, 1.0, 1.0))
+    assert fixes[0].xy_px == pytest.approx((34.5, 24.5), abs=0.05)
+    assert fixes[1].xy_px == pytest.approx((70.5, 24.5), abs=0.05)

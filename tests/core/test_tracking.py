@@ -52,6 +52,21 @@ def test_tracking_matches_full_search_on_a_moving_sequence():
     assert assert_same_readings(list(moving_sequence(24))) >= 18
 
 
+def crowd(frames: int, n: int = 10, seed: int = 1):
+    """``n`` landmarks side by side across the whole view, swaying together."""
+    rng = np.random.default_rng(seed)
+    bearings = np.linspace(-0.40, 0.40, n)
+    for i in range(frames):
+        sway = 0.01 * math.sin(i / 3.0)
+        lms = tuple(LandmarkPose(0.5 if k % 2 else 1.2, float(b) + sway) for k, b in enumerate(bearings))
+        yield render(Scene(landmarks=lms, wall_distance_m=2.5, imaging=NOISE), rng)
+
+
+def test_tracking_matches_full_search_with_ten_landmarks_side_by_side():
+    # neighbours reach into each other's windows: their bands must not pull the centroids
+    assert assert_same_readings(list(crowd(12))) >= 9
+
+
 @pytest.mark.parametrize("appears", range(3, 3 + 8))  # every phase of the full-scan cycle
 def test_a_newcomer_is_found_within_full_scan_every_frames(appears):
     cfg = load_config(None)

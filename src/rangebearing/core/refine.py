@@ -105,6 +105,38 @@ def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: Margin) -> Tuple[in
     return x0, y0, x0 + max(f, (x1 - x0) // f * f), y0 + max(f, (y1 - y0) // f * f), f
 
 
+def _blank_neighbours(
+    stack: np.ndarray, regions: Sequence[Tuple[int, int, int, int, int]], boxes: Sequence[BBox], is_red: Sequence[bool]
+) -> None:
+    """Black out, in each tile, the other bands of its colour that reach into it.
+
+    Landmarks side by side put each other's bands inside their measuring
+    windows; a neighbour's band would pull the centroid towards it.
+    """
+    if len(boxes) < 2:
+        return
+    b = np.asarray(boxes, np.int64)
+    bx0, by0 = b[:, 0] - 1, b[:, 1] - 1
+    bx1, by1 = b[:, 0] + b[:, 2] + 1, b[:, 1] + b[:, 3] + 1
+    r = np.asarray([reg[:4] for reg in regions], np.int64)
+    red = np.asarray(is_red, bool)
+    hit = (
+        (bx0[None, :] < r[:, 2:3])
+        & (bx1[None, :] > r[:, 0:1])
+        & (by0[None, :] < r[:, 3:4])
+        & (by1[None, :] > r[:, 1:2])
+        & (red[None, :] == red[:, None])
+    )
+    np.fill_diagonal(hit, False)
+    for j, i in zip(*np.nonzero(hit)):
+        x0, y0, _, _, f = regions[j]
+        stack[
+            j,
+            max(0, (by0[i] - y0) // f) : max(0, -(-(by1[i] - y0) // f)),
+            max(0, (bx0[i] - x0) // f) : max(0, -(-(bx1[i] - x0) // f)),
+        ] = 0
+
+
 def measure_bands(
     bgr: np.ndarray,
     boxes: Sequence[BBox],
@@ -144,6 +176,7 @@ def measure_bands(
     stack = np.zeros((len(crops), th, tw, 3), np.uint8)
     for tile, crop in zip(stack, crops):
         tile[: crop.shape[0], : crop.shape[1]] = crop
+    _blank_neighbours(stack, regions, [boxes[k] for k in order], [is_red[k] for k in order])
     hsv = to_hsv(apply_gains(stack.reshape(-1, tw, 3), gains)).reshape(stack.shape)
     x, y, mass, ok = tile_centroids(*band_weights(hsv, sum(1 for r in is_red if r), cfg))
     out: List[Optional[BandFix]] = [None] * len(boxes)

@@ -40,7 +40,7 @@ def _moved(box: BBox, dx: float, dy: float) -> BBox:
 
 def motion_margin(box: BBox) -> Margin:
     """How far a band may stray from its predicted box between frames (pixels, x and y)."""
-    return (box[2] // 2 + 6, box[3] // 2 + 3)
+    return (box[2] // 3 + 4, box[3] // 3 + 2)
 
 
 def search_boxes(track: Track) -> Tuple[BBox, BBox]:
