@@ -32,8 +32,10 @@ def find_blobs(
     Returns
     -------
     list of Blob
-        Centroid (area moments of the outline), area and bounding box, mapped
-        so that mask pixel centre i lands on ``offset + (i + 0.5)·scale − 0.5``.
+        Box centre, box area and bounding box, mapped so that mask pixel
+        centre i lands on ``offset + (i + 0.5)·scale − 0.5``. Coarse on
+        purpose: they only locate and pair bands; the sub-pixel centroids come
+        from :mod:`rangebearing.core.refine`.
     """
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
     ox, oy = offset_px
@@ -41,25 +43,15 @@ def find_blobs(
     s2 = scale * scale
     for c in contours:
         x, y, w, h = cv2.boundingRect(c)
-        area = float(w * h) if len(c) < 3 else max(cv2.contourArea(c), 0.5 * w * h)
-        if area * s2 < min_area_px:
+        area = w * h * s2  # the box's area: enough to drop specks and to pair; refinement measures the rest
+        if area < min_area_px:
             continue
-        m = cv2.moments(c)
-        if m["m00"] > 0:
-            cx, cy = m["m10"] / m["m00"], m["m01"] / m["m00"]
-        else:
-            cx, cy = x + (w - 1) / 2.0, y + (h - 1) / 2.0
         blobs.append(
             Blob(
-                cx_px=ox + (cx + 0.5) * scale - 0.5,
-                cy_px=oy + (cy + 0.5) * scale - 0.5,
-                area_px=area * s2,
-                bbox_px=(
-                    int(ox + x * scale),
-                    int(oy + y * scale),
-                    round(w * scale),
-                    round(h * scale),
-                ),
+                cx_px=ox + (x + w / 2.0) * scale - 0.5,
+                cy_px=oy + (y + h / 2.0) * scale - 0.5,
+                area_px=float(area),
+                bbox_px=(int(ox + x * scale), int(oy + y * scale), round(w * scale), round(h * scale)),
             )
         )
     return blobs

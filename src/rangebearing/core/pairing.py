@@ -9,8 +9,9 @@ misaligned red/blue pairs fail one of these tests.
 
 from __future__ import annotations
 
-import math
 from typing import List, Sequence
+
+import numpy as np
 
 from .._compat import frozen
 from .types import BandPair, Blob, LandmarkGeometry
@@ -32,28 +33,55 @@ class PairingLimits:
 DEFAULT_LIMITS = PairingLimits()
 
 
-def pair_score(red: Blob, blue: Blob, geometry: LandmarkGeometry, lim: PairingLimits) -> float:
-    """How badly ``red`` over ``blue`` deviates from a landmark; ``inf`` if it cannot be one."""
-    w = max(red.width_px, blue.width_px, 1)
-    if min(red.width_px, blue.width_px) + lim.slack_px < lim.width_ratio_min * w:
-        return math.inf
-    dy = blue.cy_px - red.cy_px
-    if dy <= 0:
-        return math.inf
-    expected = w * geometry.band_spacing_m / geometry.diameter_m
+def _features(blobs: Sequence[Blob]) -> np.ndarray:
+    """(N, 4) array of cx, cy, width, height."""
+    return np.array([(b.cx_px, b.cy_px, b.bbox_px[2], b.bbox_px[3]) for b in blobs], np.float64).reshape(-1, 4)
+
+
+def _band_shaped(f: np.ndarray, lim: PairingLimits) -> np.ndarray:
+    """Which blobs have a band's height-to-width ratio (a red wall or a speck does not)."""
+    w = np.maximum(f[:, 2], 1.0)
+    slack = lim.slack_px / w
+    aspect = f[:, 3] / w
+    return (aspect >= lim.band_aspect_lo - slack) & (aspect <= lim.band_aspect_hi + slack)
+
+
+def pair_scores(
+    reds: Sequence[Blob], blues: Sequence[Blob], geometry: LandmarkGeometry, lim: PairingLimits = DEFAULT_LIMITS
+) -> np.ndarray:
+    """(R, B) array: how badly red i over blue j deviates from a landmark; ``inf`` if it cannot be one.
+
+    A landmark's bands have similar widths w, the blue centroid lies below the
+    red one by about ``w·spacing/diameter``, and they are horizontally aligned.
+    The score adds the log spacing ratio, the horizontal offset in widths and the
+    log width ratio; 0 is a perfect landmark.
+    """
+    r, b = _features(reds), _features(blues)
+    rw, bw = np.maximum(r[:, 2:3], 1.0), np.maximum(b[:, 2], 1.0)[None, :]
+    w = np.maximum(rw, bw)
+    narrow = np.minimum(rw, bw)
+    dy = b[None, :, 1] - r[:, 1:2]
+    expected = w * (geometry.band_spacing_m / geometry.diameter_m)
     ratio = dy / expected
     slack = lim.slack_px / expected
-    if not lim.spacing_lo - slack <= ratio <= lim.spacing_hi + slack:
-        return math.inf
-    dx = abs(blue.cx_px - red.cx_px)
-    if dx > lim.max_dx * w + lim.slack_px:
-        return math.inf
-    for b in (red, blue):
-        aspect_slack = lim.slack_px / b.width_px if b.width_px else 0.0
-        aspect = b.height_px / max(b.width_px, 1)
-        if not lim.band_aspect_lo - aspect_slack <= aspect <= lim.band_aspect_hi + aspect_slack:
-            return math.inf
-    return abs(math.log(ratio)) + dx / w + abs(math.log(max(red.width_px, 1) / max(blue.width_px, 1)))
+    dx = np.abs(b[None, :, 0] - r[:, 0:1])
+    ok = (
+        (narrow + lim.slack_px >= lim.width_ratio_min * w)
+        & (dy > 0)
+        & (ratio >= lim.spacing_lo - slack)
+        & (ratio <= lim.spacing_hi + slack)
+        & (dx <= lim.max_dx * w + lim.slack_px)
+        & _band_shaped(r, lim)[:, None]
+        & _band_shaped(b, lim)[None, :]
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        score = np.abs(np.log(ratio)) + dx / w + np.abs(np.log(rw / bw))
+    return np.where(ok, score, np.inf)
+
+
+def pair_score(red: Blob, blue: Blob, geometry: LandmarkGeometry, lim: PairingLimits = DEFAULT_LIMITS) -> float:
+    """:func:`pair_scores` for one red and one blue blob."""
+    return float(pair_scores([red], [blue], geometry, lim)[0, 0])
 
 
 def pair_bands(
@@ -67,13 +95,11 @@ def pair_bands(
 
     Returns the accepted pairs, best-fitting first; unpaired blobs are dropped.
     """
-    candidates = []
-    for i, r in enumerate(reds):
-        for j, b in enumerate(blues):
-            s = pair_score(r, b, geometry, limits)
-            if s < math.inf:
-                candidates.append((s, i, j))
-    candidates.sort()
+    if not reds or not blues:
+        return []
+    scores = pair_scores(reds, blues, geometry, limits)
+    ri, bi = np.nonzero(np.isfinite(scores))
+    candidates = sorted(zip(scores[ri, bi].tolist(), ri.tolist(), bi.tolist()))
     used_r, used_b, pairs = set(), set(), []
     for _s, i, j in candidates:
         if i in used_r or j in used_b:
