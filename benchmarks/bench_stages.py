@@ -44,14 +44,14 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
     from rangebearing.core.blobs import find_blobs
     from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
     from rangebearing.core.denoise import band_preserving_ksize, majority_filter
-    from rangebearing.core.detect import refine
+    from rangebearing.core.detect import downscale, refine
+    from rangebearing.core.refine import Pyramid
     from rangebearing.core.model import in_envelope, reading
     from rangebearing.core.pairing import PairingLimits, pair_bands
 
     det, geom, cam = cfg.detection, cfg.landmark, cfg.camera
     h, w = frames[0].shape[:2]
     s = det.downscale
-    x0, y0, x1, y1 = 0, 0, w // s * s, h // s * s
     band_px = cam.fy_px * geom.band_height_m / cfg.model.envelope_range_m[1] / s
     ksize = band_preserving_ksize(det.median_ksize, band_px)
     limits, min_area = PairingLimits(), det.min_band_px * det.min_band_px
@@ -65,9 +65,8 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             laps.start()
             gains = grey_world_gains(cv2.resize(frame, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST))
             laps.lap("grey_world_gains (1/8 thumbnail)")
-            roi = frame[y0:y1, x0:x1]
-            small = roi if s == 1 else cv2.resize(roi, ((x1 - x0) // s, (y1 - y0) // s), interpolation=cv2.INTER_AREA)
-            laps.lap(f"region_masks: resize 1/{s} (INTER_AREA)")
+            small = downscale(frame, s)
+            laps.lap(f"downscale 1/{s} (INTER_AREA)")
             balanced = apply_gains(small, gains)
             laps.lap("region_masks: apply_gains")
             hsv = to_hsv(balanced)
@@ -76,12 +75,12 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             laps.lap("region_masks: class_masks")
             red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
             laps.lap(f"region_masks: majority_filter ×2 (k={ksize})")
-            reds = find_blobs(red, s, (x0, y0), min_area)
-            blues = find_blobs(blue, s, (x0, y0), min_area)
+            reds = find_blobs(red, s, (0, 0), min_area)
+            blues = find_blobs(blue, s, (0, 0), min_area)
             laps.lap("find_blobs ×2")
             pairs = pair_bands(reds, blues, geom, limits, det.max_landmarks) if reds and blues else []
             laps.lap("pair_bands")
-            centroids = refine(frame, pairs, det, gains)
+            centroids = refine(frame, pairs, det, gains, Pyramid(frame, small if s == 2 else None))
             laps.lap("refine_pairs (detect.refine)")
             for c in centroids:
                 rng, bearing, *_ = reading(c.red_xy_px, c.blue_xy_px, cam, cfg.model, geom)

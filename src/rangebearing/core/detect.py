@@ -17,7 +17,7 @@ the moments of the whole red and blue masks — one landmark at most.
 
 from __future__ import annotations
 
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -28,10 +28,8 @@ from .blobs import find_blobs, mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
-from .refine import refine_pairs
+from .refine import Pyramid, refine_pairs
 from .types import XY, BandPair, BBox, union
-
-Region = Tuple[int, int, int, int]  # x0, y0, x1, y1 (exclusive), full-resolution pixels
 
 
 @frozen
@@ -54,45 +52,41 @@ class BandCentroids:
         return union(self.red_bbox_px, self.blue_bbox_px)
 
 
-def region_masks(
-    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int
-) -> Tuple[np.ndarray, np.ndarray]:
-    """Filtered red and blue masks of one region at ``1/cfg.downscale`` resolution."""
-    x0, y0, x1, y1 = region
-    s = cfg.downscale
-    roi = bgr[y0:y1, x0:x1]
-    small = roi if s == 1 else cv2.resize(roi, ((x1 - x0) // s, (y1 - y0) // s), interpolation=cv2.INTER_AREA)
+def downscale(bgr: np.ndarray, s: int) -> np.ndarray:
+    """Area-average the frame by ``s`` (trimming to a multiple of ``s``); ``s = 1`` returns it."""
+    if s == 1:
+        return bgr
+    h, w = bgr.shape[:2]
+    return cv2.resize(bgr[: h // s * s, : w // s * s], (w // s, h // s), interpolation=cv2.INTER_AREA)
+
+
+def region_masks(small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
+    """Filtered red and blue masks of a downscaled frame: balance, HSV, thresholds, majority filter."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
     return majority_filter(red, ksize), majority_filter(blue, ksize)
 
 
 def find_pairs(
-    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
+    small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
 ) -> List[BandPair]:
-    """Candidate landmarks (paired band blobs) inside one region of the frame."""
-    red, blue = region_masks(bgr, region, cfg, gains, ksize)
+    """Candidate landmarks (paired band blobs) in a frame downscaled by ``cfg.downscale``; full-resolution boxes."""
+    red, blue = region_masks(small, cfg, gains, ksize)
     s = cfg.downscale
     min_area = cfg.min_band_px * cfg.min_band_px
-    off = (region[0], region[1])
-    reds = find_blobs(red, s, off, min_area)
-    blues = find_blobs(blue, s, off, min_area)
+    reds = find_blobs(red, s, (0, 0), min_area)
+    blues = find_blobs(blue, s, (0, 0), min_area)
     if not reds or not blues:
         return []
     return pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
 
 
-def detect_region(
-    bgr: np.ndarray, region: Region, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
+def refine(
+    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains, pyramid: Optional[Pyramid] = None
 ) -> List[BandCentroids]:
-    """Every landmark's band centroids inside one region (fast path)."""
-    return refine(bgr, find_pairs(bgr, region, cfg, gains, ksize, limits, geometry), cfg, gains)
-
-
-def refine(bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains) -> List[BandCentroids]:
     """Sub-pixel centroids of every pair (one batch); pairs whose bands vanish are dropped."""
     found = []
-    for pair, fix in zip(pairs, refine_pairs(bgr, pairs, cfg, gains)):
+    for pair, fix in zip(pairs, refine_pairs(bgr, pairs, cfg, gains, pyramid)):
         if fix is not None:
             red, blue = fix
             found.append(

@@ -18,9 +18,10 @@ from ..config import Config
 from ..errors import FrameError
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, detect_paper, find_pairs, refine
+from .detect import BandCentroids, detect_paper, downscale, find_pairs, refine
 from .model import in_envelope, reading
 from .pairing import PairingLimits
+from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark
 
@@ -102,11 +103,9 @@ class Pipeline:
                 if det.white_balance == "grey_world":
                     thumb = cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST)
                     self._gains = grey_world_gains(thumb)
-                s = det.downscale
-                pairs = find_pairs(
-                    bgr, (0, 0, w // s * s, h // s * s), det, self._gains, ksize, self.limits, self.cfg.landmark
-                )
-                found = refine(bgr, pairs, det, self._gains)
+                small = downscale(bgr, det.downscale)
+                pairs = find_pairs(small, det, self._gains, ksize, self.limits, self.cfg.landmark)
+                found = refine(bgr, pairs, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)

@@ -80,6 +80,28 @@ def tile_centroids(w_x: np.ndarray, w_y: np.ndarray) -> Tuple[np.ndarray, np.nda
 Margin = Tuple[int, int]  # grow a band's box by (x, y) pixels on each side
 
 
+class Pyramid:
+    """Area-averaged copies of one frame at ½, ¼, ⅛, made on demand and kept for the frame.
+
+    Level f holds the means of the frame's f×f blocks on a grid fixed to the
+    frame, so a crop of it equals an area-resize of the same region.
+    """
+
+    def __init__(self, bgr: np.ndarray, half: Optional[np.ndarray] = None) -> None:
+        self._levels = {1: bgr}
+        if half is not None:
+            self._levels[2] = half
+
+    def level(self, f: int) -> np.ndarray:
+        if f not in self._levels:
+            finer = self.level(f // 2)
+            h, w = finer.shape[:2]
+            self._levels[f] = cv2.resize(
+                finer[: h // 2 * 2, : w // 2 * 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA
+            )
+        return self._levels[f]
+
+
 @frozen
 class BandFix:
     """One band measured on the unfiltered pixels.
@@ -97,7 +119,8 @@ def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: Margin) -> Tuple[in
     h, w = shape[:2]
     bx, by, bw, bh = bbox
     mx, my = margin
-    f = max(1, bh // REFINE_BAND_PX)
+    k = bh // REFINE_BAND_PX
+    f = 1 if k < 2 else 2 if k < 4 else 4 if k < 8 else 8
     # Downscaled pixels sit on a grid fixed to the frame, so a band gives the same
     # weights whatever box it is measured in (tracking windows and full scans agree).
     x0, y0 = max(0, bx - mx) // f * f, max(0, by - my) // f * f
@@ -144,6 +167,7 @@ def measure_bands(
     margins: Sequence[Margin],
     cfg: DetectionConfig,
     gains: Gains,
+    pyramid: Optional[Pyramid] = None,
 ) -> List[Optional[BandFix]]:
     """Measure each band inside its box grown by its margin; ``None`` where nothing of its colour is left.
 
@@ -154,6 +178,9 @@ def measure_bands(
     boxes, is_red, margins : sequences of equal length
         Each band's box (x, y, w, h) in full-resolution pixels, its colour, and
         how far to grow the box on each side.
+    pyramid : Pyramid, optional
+        Downscaled copies of the frame to crop tall bands from; without it each
+        tall band's region is resized on its own (the same pixels either way).
 
     Returns
     -------
@@ -166,11 +193,13 @@ def measure_bands(
     regions = [_band_region(bgr.shape, boxes[k], margins[k]) for k in order]
     crops = []
     for x0, y0, x1, y1, f in regions:
-        roi = bgr[y0:y1, x0:x1]
-        if f > 1:  # at exactly ½ bilinear is the 2×2 box average, and cheaper than INTER_AREA
+        if f == 1:
+            crops.append(bgr[y0:y1, x0:x1])
+        elif pyramid is not None:
+            crops.append(pyramid.level(f)[y0 // f : y1 // f, x0 // f : x1 // f])
+        else:  # at exactly ½ bilinear is the 2×2 box average, and cheaper than INTER_AREA
             interp = cv2.INTER_LINEAR if f == 2 else cv2.INTER_AREA
-            roi = cv2.resize(roi, ((x1 - x0) // f, (y1 - y0) // f), interpolation=interp)
-        crops.append(roi)
+            crops.append(cv2.resize(bgr[y0:y1, x0:x1], ((x1 - x0) // f, (y1 - y0) // f), interpolation=interp))
     th = max(c.shape[0] for c in crops)
     tw = max(c.shape[1] for c in crops)
     stack = np.zeros((len(crops), th, tw, 3), np.uint8)
@@ -188,7 +217,7 @@ def measure_bands(
 
 
 def refine_pairs(
-    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains
+    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains, pyramid: Optional[Pyramid] = None
 ) -> List[Optional[Tuple[BandFix, BandFix]]]:
     """Measure both bands of each pair (one batch); ``None`` for a pair whose band vanished.
 
@@ -197,7 +226,7 @@ def refine_pairs(
     """
     m = cfg.downscale + 1
     boxes = [b.bbox_px for p in pairs for b in (p.red, p.blue)]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(pairs), [(m, m)] * len(boxes), cfg, gains)
+    fixes = measure_bands(bgr, boxes, [True, False] * len(pairs), [(m, m)] * len(boxes), cfg, gains, pyramid)
     out: List[Optional[Tuple[BandFix, BandFix]]] = []
     for red, blue in zip(fixes[0::2], fixes[1::2]):
         out.append(None if red is None or blue is None else (red, blue))
