@@ -45,9 +45,9 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
     from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
     from rangebearing.core.denoise import band_preserving_ksize, majority_filter
     from rangebearing.core.detect import downscale, refine
-    from rangebearing.core.refine import Pyramid
     from rangebearing.core.model import in_envelope, reading
     from rangebearing.core.pairing import PairingLimits, pair_bands
+    from rangebearing.core.refine import Pyramid
 
     det, geom, cam = cfg.detection, cfg.landmark, cfg.camera
     h, w = frames[0].shape[:2]
