@@ -100,13 +100,16 @@ def step(
         if red is None or blue is None or not plausible(t.bands, red, blue, geometry, limits):
             lost = True
             continue
-        new = advance(t, red, blue)
-        # two tracks that converged on one landmark: keep the first
-        if any(
-            abs(new.bands.red_xy_px[0] - k.bands.red_xy_px[0]) < 0.5 * new.bands.width_px
-            and abs(new.bands.red_xy_px[1] - k.bands.red_xy_px[1]) < 0.5 * new.bands.width_px
-            for k in kept
-        ):
-            continue
-        kept.append(new)
-    return kept, lost
+        kept.append(advance(t, red, blue))
+    return _distinct(kept), lost
+
+
+def _distinct(tracks: List[Track]) -> List[Track]:
+    """Drop a track that converged onto an earlier one's landmark (red centroids within half a width)."""
+    if len(tracks) < 2:
+        return tracks
+    xy = np.array([t.bands.red_xy_px for t in tracks])
+    near = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+    half_width = 0.5 * np.array([t.bands.width_px for t in tracks])
+    dup = np.triu(near < half_width[:, None], k=1).any(axis=0)
+    return [t for t, d in zip(tracks, dup) if not d]
