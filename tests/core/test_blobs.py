@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from rangebearing.core.blobs import find_blobs, mask_centroid, weighted_centroid
+from rangebearing.core.blobs import find_blobs, mask_centroid
 
 
 def test_find_blobs_maps_downscaled_coordinates_to_full_resolution():
@@ -20,28 +20,6 @@ def test_find_blobs_drops_small_regions_and_separates_regions():
     mask[18, 28] = 255
     blobs = find_blobs(mask, min_area_px=4)
     assert len(blobs) == 2
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_weighted_centroid_is_translation_invariant(dtype):
-    w = np.zeros((20, 20), dtype)
-    w[3:6, 4:9] = 1.0
-    w[5, 9] = 0.5
-    x0, y0, m0 = weighted_centroid(w)
-    x1, y1, m1 = weighted_centroid(np.roll(np.roll(w, 3, axis=1), 7, axis=0))
-    assert (x1 - x0, y1 - y0) == pytest.approx((3, 7))
-    assert m1 == pytest.approx(m0)
-
-
-def test_weighted_centroid_sub_pixel_from_partial_weights():
-    w = np.zeros((5, 5), np.float32)
-    w[2, 1] = 1.0
-    w[2, 2] = 1.0
-    w[2, 3] = 0.5  # half-covered edge pixel pulls the centroid right
-    x, y, _ = weighted_centroid(w)
-    assert x == pytest.approx((1 + 2 + 1.5) / 2.5)
-    assert y == pytest.approx(2.0)
-    assert weighted_centroid(np.zeros((3, 3), np.float32)) is None
 
 
 def test_mask_centroid_of_a_rectangle():

@@ -57,18 +57,6 @@ def find_blobs(
     return blobs
 
 
-def weighted_centroid(weights: np.ndarray) -> Optional[Tuple[float, float, float]]:
-    """Centroid ``(x, y, mass)`` of a non-negative weight image (first-order moments).
-
-    Returns ``None`` when the total weight is zero. Moments are translation
-    invariant: shifting the weights by (dx, dy) shifts the centroid by the same.
-    """
-    m = cv2.moments(weights)
-    if m["m00"] <= 1e-9:
-        return None
-    return m["m10"] / m["m00"], m["m01"] / m["m00"], m["m00"]
-
-
 def mask_centroid(mask: np.ndarray) -> Optional[Tuple[float, float, float]]:
     """The paper's moment centroid of a binary mask: ``(x, y, area_px)`` or ``None``."""
     m = cv2.moments(mask, binaryImage=True)

@@ -1,6 +1,6 @@
-"""Band detection in a frame or a window of it: the fast path and the paper's path.
+"""Band detection in a whole frame: the fast path and the paper's path.
 
-Fast path (default), per region of the frame::
+Fast path (default)::
 
     downscale (area) → grey-world balance → HSV → red/blue hue thresholds
     → median (majority) filter of the masks, sized to keep the farthest band
@@ -13,6 +13,9 @@ and moves the centroids, which costs range accuracy.
 
 Paper path: median filter over the whole colour frame, HSV, thresholds, and
 the moments of the whole red and blue masks — one landmark at most.
+
+Between full scans, :mod:`rangebearing.core.tracking` measures known landmarks
+in place instead.
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
 """The pipeline: one BGR frame in, every landmark's range and bearing out.
 
-:class:`Pipeline` is pure apart from its own state: it keeps the previous
-frame's landmarks when tracking, so that the next frame is searched only in
-windows around them, with a full-frame search every ``full_scan_every``
-frames (and whenever nothing is tracked) so that a newcomer is found within
-that many frames.
+:class:`Pipeline` is pure apart from its own state: when tracking it keeps the
+previous frame's landmarks and measures them again in small windows where they
+should be (:mod:`rangebearing.core.tracking`), with a full-frame search every
+``full_scan_every`` frames, after a landmark is lost, and whenever nothing is
+tracked, so a newcomer is found within ``full_scan_every`` frames.
 """
 
 from __future__ import annotations
