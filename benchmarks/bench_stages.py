@@ -41,7 +41,7 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
     Returns ``([(stage, median_ms), …, ("Pipeline.process (whole)", ms)], landmarks_found)``,
     the count from the last frame, so a breakdown that finds nothing is visible.
     """
-    from rangebearing.core.blobs import find_blobs
+    from rangebearing.core.blobs import find_boxes
     from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
     from rangebearing.core.denoise import band_preserving_ksize, majority_filter
     from rangebearing.core.detect import downscale, refine
@@ -75,12 +75,14 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             laps.lap("region_masks: class_masks")
             red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
             laps.lap(f"region_masks: majority_filter ×2 (k={ksize})")
-            reds = find_blobs(red, s, (0, 0), min_area)
-            blues = find_blobs(blue, s, (0, 0), min_area)
-            laps.lap("find_blobs ×2")
-            pairs = pair_bands(reds, blues, geom, limits, det.max_landmarks) if reds and blues else []
+            reds = find_boxes(red, s, min_area)
+            blues = find_boxes(blue, s, min_area)
+            laps.lap("find_boxes ×2")
+            idx = np.array(pair_bands(reds, blues, geom, limits, det.max_landmarks), np.int64).reshape(-1, 2)
             laps.lap("pair_bands")
-            centroids = refine(frame, pairs, det, gains, Pyramid(frame, small if s == 2 else None))
+            centroids = refine(
+                frame, reds[idx[:, 0]], blues[idx[:, 1]], det, gains, Pyramid(frame, small if s == 2 else None)
+            )
             laps.lap("refine_pairs (detect.refine)")
             for c in centroids:
                 rng, bearing, *_ = reading(c.red_xy_px, c.blue_xy_px, cam, cfg.model, geom)

@@ -4,7 +4,6 @@ import pytest
 from rangebearing.config import DetectionConfig
 from rangebearing.core.color import to_hsv
 from rangebearing.core.refine import band_weights, measure_bands, refine_pairs, tile_centroids
-from rangebearing.core.types import BandPair, Blob
 
 CFG = DetectionConfig()
 RED, BLUE = np.array([40, 40, 200.0]), np.array([200, 60, 30.0])
@@ -55,8 +54,8 @@ def test_tile_centroids_by_hand_and_empty_tiles():
     assert x[0] == pytest.approx((1 + 2 + 1.5) / 2.5) and y[0] == pytest.approx(1.0)
 
 
-def band(x, y, w, h):
-    return Blob(x + (w - 1) / 2, y + (h - 1) / 2, w * h, (x, y, w, h))
+def boxes(*b):
+    return np.array(b, np.int64).reshape(-1, 4)
 
 
 @pytest.mark.parametrize("scale_rows", [6, 30])  # small bands at full resolution, tall ones at 1/f
@@ -65,8 +64,7 @@ def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_ro
     h = scale_rows
     img[20 : 20 + h, 40:80] = RED
     img[100 : 100 + h, 42:82] = BLUE
-    pair = BandPair(red=band(40, 20, 40, h), blue=band(42, 100, 40, h))
-    red, blue = refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0))[0]
+    red, blue = refine_pairs(img, boxes((40, 20, 40, h)), boxes((42, 100, 40, h)), CFG, (1.0, 1.0, 1.0))[0]
     (rx, ry), (bx, by) = red.xy_px, blue.xy_px
     assert red.mass_px == pytest.approx(40 * h, rel=0.1)  # the weight is about the band area
     # y weights are linear in coverage: exact. x weights ramp with saturation, which is not
@@ -79,17 +77,15 @@ def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_ro
 def test_a_pair_whose_band_vanished_gives_none():
     img = np.full((100, 100, 3), 220, np.uint8)
     img[10:16, 10:40] = RED  # no blue anywhere
-    pair = BandPair(red=band(10, 10, 30, 6), blue=band(10, 50, 30, 6))
-    assert refine_pairs(img, [pair], CFG, (1.0, 1.0, 1.0)) == [None]
-    assert refine_pairs(img, [], CFG, (1.0, 1.0, 1.0)) == []
+    assert refine_pairs(img, boxes((10, 10, 30, 6)), boxes((10, 50, 30, 6)), CFG, (1.0, 1.0, 1.0)) == [None]
+    assert refine_pairs(img, boxes(), boxes(), CFG, (1.0, 1.0, 1.0)) == []
 
 
 def test_a_neighbouring_band_inside_the_window_does_not_pull_the_centroid():
     img = np.full((60, 120, 3), 220, np.uint8)
     img[20:30, 20:50] = RED
     img[20:30, 56:86] = RED  # another landmark's red band, 6 px to the right
-    alone = band(20, 20, 30, 10)
-    other = band(56, 20, 30, 10)
-    fixes = measure_bands(img, [alone.bbox_px, other.bbox_px], [True, True], [(12, 4), (12, 4)], CFG, (1.0, 1.0, 1.0))
+    alone, other = (20, 20, 30, 10), (56, 20, 30, 10)
+    fixes = measure_bands(img, [alone, other], [True, True], [(12, 4), (12, 4)], CFG, (1.0, 1.0, 1.0))
     assert fixes[0].xy_px == pytest.approx((34.5, 24.5), abs=0.05)
     assert fixes[1].xy_px == pytest.approx((70.5, 24.5), abs=0.05)

@@ -20,19 +20,19 @@ in place instead.
 
 from __future__ import annotations
 
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
 from ..config import DetectionConfig
-from .blobs import find_blobs, mask_centroid
+from .blobs import find_boxes, mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
 from .refine import Pyramid, refine_pairs
-from .types import XY, BandPair, BBox, union
+from .types import XY, BBox, union
 
 
 @frozen
@@ -72,29 +72,36 @@ def region_masks(small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: i
 
 def find_pairs(
     small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
-) -> List[BandPair]:
-    """Candidate landmarks (paired band blobs) in a frame downscaled by ``cfg.downscale``; full-resolution boxes."""
+) -> Tuple[np.ndarray, np.ndarray]:
+    """Candidate landmarks in a frame downscaled by ``cfg.downscale``.
+
+    Returns the red and the blue band boxes of each candidate, (K, 4) arrays
+    in full-resolution pixels, row k of one paired with row k of the other.
+    """
     red, blue = region_masks(small, cfg, gains, ksize)
-    s = cfg.downscale
     min_area = cfg.min_band_px * cfg.min_band_px
-    reds = find_blobs(red, s, (0, 0), min_area)
-    blues = find_blobs(blue, s, (0, 0), min_area)
-    if not reds or not blues:
-        return []
-    return pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
+    reds = find_boxes(red, cfg.downscale, min_area)
+    blues = find_boxes(blue, cfg.downscale, min_area)
+    pairs = pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
+    idx = np.array(pairs, np.int64).reshape(-1, 2)
+    return reds[idx[:, 0]], blues[idx[:, 1]]
 
 
 def refine(
-    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains, pyramid: Optional[Pyramid] = None
+    bgr: np.ndarray,
+    red_boxes: np.ndarray,
+    blue_boxes: np.ndarray,
+    cfg: DetectionConfig,
+    gains: Gains,
+    pyramid: Optional[Pyramid] = None,
 ) -> List[BandCentroids]:
-    """Sub-pixel centroids of every pair (one batch); pairs whose bands vanish are dropped."""
+    """Sub-pixel centroids of every candidate (one batch); candidates whose bands vanish are dropped."""
     found = []
-    for pair, fix in zip(pairs, refine_pairs(bgr, pairs, cfg, gains, pyramid)):
+    fixes = refine_pairs(bgr, red_boxes, blue_boxes, cfg, gains, pyramid)
+    for rb, bb, fix in zip(red_boxes.tolist(), blue_boxes.tolist(), fixes):
         if fix is not None:
             red, blue = fix
-            found.append(
-                BandCentroids(red.xy_px, blue.xy_px, pair.red.bbox_px, pair.blue.bbox_px, red.mass_px, blue.mass_px)
-            )
+            found.append(BandCentroids(red.xy_px, blue.xy_px, tuple(rb), tuple(bb), red.mass_px, blue.mass_px))
     return found
 
 

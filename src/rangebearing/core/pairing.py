@@ -9,12 +9,12 @@ misaligned red/blue pairs fail one of these tests.
 
 from __future__ import annotations
 
-from typing import List, Sequence
+from typing import List, Tuple
 
 import numpy as np
 
 from .._compat import frozen
-from .types import BandPair, Blob, LandmarkGeometry
+from .types import LandmarkGeometry
 
 
 @frozen
@@ -33,13 +33,14 @@ class PairingLimits:
 DEFAULT_LIMITS = PairingLimits()
 
 
-def _features(blobs: Sequence[Blob]) -> np.ndarray:
-    """(N, 4) array of cx, cy, width, height."""
-    return np.array([(b.cx_px, b.cy_px, b.bbox_px[2], b.bbox_px[3]) for b in blobs], np.float64).reshape(-1, 4)
+def _features(boxes: np.ndarray) -> np.ndarray:
+    """(N, 4) float array of centre x, centre y, width, height (pixel centres at integers)."""
+    b = np.asarray(boxes, np.float64).reshape(-1, 4)
+    return np.column_stack((b[:, 0] + b[:, 2] / 2 - 0.5, b[:, 1] + b[:, 3] / 2 - 0.5, b[:, 2], b[:, 3]))
 
 
 def _band_shaped(f: np.ndarray, lim: PairingLimits) -> np.ndarray:
-    """Which blobs have a band's height-to-width ratio (a red wall or a speck does not)."""
+    """Which boxes have a band's height-to-width ratio (a red wall or a speck does not)."""
     w = np.maximum(f[:, 2], 1.0)
     slack = lim.slack_px / w
     aspect = f[:, 3] / w
@@ -47,16 +48,16 @@ def _band_shaped(f: np.ndarray, lim: PairingLimits) -> np.ndarray:
 
 
 def pair_scores(
-    reds: Sequence[Blob], blues: Sequence[Blob], geometry: LandmarkGeometry, lim: PairingLimits = DEFAULT_LIMITS
+    red_boxes: np.ndarray, blue_boxes: np.ndarray, geometry: LandmarkGeometry, lim: PairingLimits = DEFAULT_LIMITS
 ) -> np.ndarray:
-    """(R, B) array: how badly red i over blue j deviates from a landmark; ``inf`` if it cannot be one.
+    """(R, B) array: how badly red box i over blue box j deviates from a landmark; ``inf`` if it cannot be one.
 
-    A landmark's bands have similar widths w, the blue centroid lies below the
+    A landmark's bands have similar widths w, the blue centre lies below the
     red one by about ``w·spacing/diameter``, and they are horizontally aligned.
     The score adds the log spacing ratio, the horizontal offset in widths and the
     log width ratio; 0 is a perfect landmark.
     """
-    r, b = _features(reds), _features(blues)
+    r, b = _features(red_boxes), _features(blue_boxes)
     rw, bw = np.maximum(r[:, 2:3], 1.0), np.maximum(b[:, 2], 1.0)[None, :]
     w = np.maximum(rw, bw)
     narrow = np.minimum(rw, bw)
@@ -79,34 +80,29 @@ def pair_scores(
     return np.where(ok, score, np.inf)
 
 
-def pair_score(red: Blob, blue: Blob, geometry: LandmarkGeometry, lim: PairingLimits = DEFAULT_LIMITS) -> float:
-    """:func:`pair_scores` for one red and one blue blob."""
-    return float(pair_scores([red], [blue], geometry, lim)[0, 0])
-
-
 def pair_bands(
-    reds: Sequence[Blob],
-    blues: Sequence[Blob],
+    red_boxes: np.ndarray,
+    blue_boxes: np.ndarray,
     geometry: LandmarkGeometry,
     limits: PairingLimits = DEFAULT_LIMITS,
     max_pairs: int = 16,
-) -> List[BandPair]:
-    """Greedy best-first pairing: each blob joins at most one landmark.
+) -> List[Tuple[int, int]]:
+    """Greedy best-first pairing: each box joins at most one landmark.
 
-    Returns the accepted pairs, best-fitting first; unpaired blobs are dropped.
+    Returns ``(red index, blue index)`` pairs, best-fitting first; the boxes left
+    over are dropped.
     """
-    if not reds or not blues:
+    if len(red_boxes) == 0 or len(blue_boxes) == 0:
         return []
-    scores = pair_scores(reds, blues, geometry, limits)
+    scores = pair_scores(red_boxes, blue_boxes, geometry, limits)
     ri, bi = np.nonzero(np.isfinite(scores))
-    candidates = sorted(zip(scores[ri, bi].tolist(), ri.tolist(), bi.tolist()))
     used_r, used_b, pairs = set(), set(), []
-    for _s, i, j in candidates:
+    for _s, i, j in sorted(zip(scores[ri, bi].tolist(), ri.tolist(), bi.tolist())):
         if i in used_r or j in used_b:
             continue
         used_r.add(i)
         used_b.add(j)
-        pairs.append(BandPair(red=reds[i], blue=blues[j]))
+        pairs.append((i, j))
         if len(pairs) >= max_pairs:
             break
     return pairs

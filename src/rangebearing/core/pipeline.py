@@ -104,8 +104,8 @@ class Pipeline:
                     thumb = cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST)
                     self._gains = grey_world_gains(thumb)
                 small = downscale(bgr, det.downscale)
-                pairs = find_pairs(small, det, self._gains, ksize, self.limits, self.cfg.landmark)
-                found = refine(bgr, pairs, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
+                reds, blues = find_pairs(small, det, self._gains, ksize, self.limits, self.cfg.landmark)
+                found = refine(bgr, reds, blues, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)

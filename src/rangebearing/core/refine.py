@@ -17,7 +17,7 @@ import numpy as np
 from .._compat import frozen
 from ..config import DetectionConfig
 from .color import CHROMA_FLOOR, Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
-from .types import XY, BandPair, BBox
+from .types import XY, BBox
 
 # Bands taller than this (full-resolution pixels) are measured at 1/f resolution,
 # so every band costs about the same whatever its range; a band still spans at
@@ -217,16 +217,22 @@ def measure_bands(
 
 
 def refine_pairs(
-    bgr: np.ndarray, pairs: Sequence[BandPair], cfg: DetectionConfig, gains: Gains, pyramid: Optional[Pyramid] = None
+    bgr: np.ndarray,
+    red_boxes: np.ndarray,
+    blue_boxes: np.ndarray,
+    cfg: DetectionConfig,
+    gains: Gains,
+    pyramid: Optional[Pyramid] = None,
 ) -> List[Optional[Tuple[BandFix, BandFix]]]:
-    """Measure both bands of each pair (one batch); ``None`` for a pair whose band vanished.
+    """Measure the red and blue band of each candidate (one batch); ``None`` where a band vanished.
 
-    Each band is measured inside its blob's box grown by ``downscale + 1`` px,
+    Row k of ``red_boxes`` and of ``blue_boxes`` (full-resolution x, y, w, h)
+    belong to candidate k. Each band is measured inside its box grown by ``downscale + 1`` px,
     which covers the downscaling and the majority filter's erosion.
     """
     m = cfg.downscale + 1
-    boxes = [b.bbox_px for p in pairs for b in (p.red, p.blue)]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(pairs), [(m, m)] * len(boxes), cfg, gains, pyramid)
+    boxes = [tuple(b) for pair in zip(red_boxes.tolist(), blue_boxes.tolist()) for b in pair]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(red_boxes), [(m, m)] * len(boxes), cfg, gains, pyramid)
     out: List[Optional[Tuple[BandFix, BandFix]]] = []
     for red, blue in zip(fixes[0::2], fixes[1::2]):
         out.append(None if red is None or blue is None else (red, blue))

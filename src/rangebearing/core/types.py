@@ -81,41 +81,6 @@ def union(a: BBox, b: BBox) -> BBox:
 
 
 @frozen
-class Blob:
-    """One connected region of a colour class, in full-resolution pixels."""
-
-    cx_px: float
-    cy_px: float
-    area_px: float
-    bbox_px: BBox
-
-    @property
-    def width_px(self) -> int:
-        return self.bbox_px[2]
-
-    @property
-    def height_px(self) -> int:
-        return self.bbox_px[3]
-
-
-@frozen
-class BandPair:
-    """A red blob paired with the blue blob below it: one landmark candidate."""
-
-    red: Blob
-    blue: Blob
-
-    @property
-    def bbox_px(self) -> BBox:
-        return union(self.red.bbox_px, self.blue.bbox_px)
-
-    @property
-    def l_px(self) -> float:
-        """Pixel distance between the band centroids (the paper's L)."""
-        return math.hypot(self.blue.cx_px - self.red.cx_px, self.blue.cy_px - self.red.cy_px)
-
-
-@frozen
 class Landmark:
     """One landmark seen in one frame: range, bearing and what they came from.
 
