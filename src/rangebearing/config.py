@@ -289,7 +289,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, Check]]] = {
         {
             "kind": _choice(*SOURCES),
             "path": _string,
-            "fps": _positive(),
+            "fps": _number(0, 1000),
             "loop": _bool,
             "device": _string,
             "camera_num": _number(0, 16, integer=True),
