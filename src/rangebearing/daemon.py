@@ -135,8 +135,7 @@ class Daemon:
                 t0 = clock()
                 result = pipe.process(frame.image)
             except FrameError as exc:
-                self.stats.bad_frames += 1
-                log.warning("bad frame skipped (%d so far): %s", self.stats.bad_frames, exc)
+                self._bad_frame("bad frame skipped", exc)
                 continue
             t1 = clock()
             t_unix = time.time() - (t1 - frame.t_mono_ns) / 1e9
@@ -145,8 +144,7 @@ class Daemon:
                     self.cfg.publish.robot_id, seq, t_unix, result.landmarks, self.stats.fps, self.dropped
                 )
             except ProtocolError as exc:  # e.g. a NaN reading: skip the frame, keep going
-                self.stats.bad_frames += 1
-                log.warning("reading not encodable, frame skipped: %s", exc)
+                self._bad_frame("reading not encodable, frame skipped", exc)
                 continue
             publisher.send(payload)
             t2 = clock()
@@ -172,6 +170,13 @@ class Daemon:
                 self.notifier.status(f"{s.fps:.1f} fps, {s.landmarks} landmarks in view, {s.dropped} dropped")
                 last_status = t2
         return 0
+
+    def _bad_frame(self, what: str, exc: Exception) -> None:
+        """Count a skipped frame; log the first three, then every hundredth (no flooding the journal)."""
+        self.stats.bad_frames += 1
+        n = self.stats.bad_frames
+        if n <= 3 or n % 100 == 0:
+            log.warning("%s (%d so far): %s", what, n, exc)
 
     def _do_reload(self, pipe: Pipeline, publisher: Publisher) -> Tuple[Pipeline, Publisher]:
         """Re-read the config file; keep everything as it was if the new one is bad."""
