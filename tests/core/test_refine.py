@@ -20,7 +20,7 @@ def test_horizontal_weights_ramp_with_saturation_and_respect_hue():
     hsv[0, 0, :, 1] = (40, 90, 200, 255)
     hsv[0, 0, :, 2] = 200
     w_x, w_y = band_weights(hsv, 1, CFG)
-    assert w_x.dtype == np.uint8 and w_y.dtype == np.uint8
+    assert w_x.dtype == np.uint8 and w_y.dtype == np.float32
     assert (w_x[0, 0] / 255).tolist() == pytest.approx([0.0, 0.5, 1.0, 0.0], abs=0.01)
     assert w_y[0, 0, 3] == 0.0
 

@@ -16,7 +16,6 @@ Gains = Tuple[float, float, float]
 HueRanges = Sequence[Tuple[int, int]]
 
 UNIT_GAINS: Gains = (1.0, 1.0, 1.0)
-CHROMA_FLOOR = 12  # chroma (max − min channel, 0–255) below which a pixel does not count
 
 
 def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:

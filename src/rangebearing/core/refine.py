@@ -16,7 +16,7 @@ import numpy as np
 
 from .._compat import frozen
 from ..config import DetectionConfig
-from .color import CHROMA_FLOOR, Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
+from .color import Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
 from .types import XY, BBox
 
 # Bands taller than this (full-resolution pixels) are measured at 1/f resolution,
@@ -24,10 +24,11 @@ from .types import XY, BBox
 # least REFINE_BAND_PX / 2 rows, ample for sub-pixel moments.
 REFINE_BAND_PX = 8
 S_RAMP = 40  # saturation ramp half-width for the horizontal weights
+CHROMA_FLOOR = 0.15  # share of a band's mean chroma where its vertical weight starts
 
 
 def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
-    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W) uint8.
+    """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W): ``w_x`` uint8 0–255, ``w_y`` float32 0–1.
 
     Parameters
     ----------
@@ -45,8 +46,9 @@ def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.
     ``s_min + 40`` (255). Saturation does not depend on brightness, so shading
     across the cylinder does not pull the *horizontal* centroid.
 
-    ``w_y`` weighs by chroma (max − min channel = S·V/255); pixels under
-    ``CHROMA_FLOOR`` weigh nothing. Chroma is linear in
+    ``w_y`` weighs by chroma (max − min channel = S·V/255) on a ramp from 15 %
+    of the band's mean chroma (0) to its mean (1): faint chroma noise of
+    neutral pixels weighs nothing and the band's core is flat. Chroma is linear in
     the share of a pixel the band covers whether the neighbour is the white body
     or the dark robot below, so the *vertical* centroid, and with it L, is
     unbiased; saturation would count a blue/black edge pixel as fully blue.
@@ -62,7 +64,15 @@ def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.
     gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, min(cfg.v_min, 10)))
     w_x = cv2.bitwise_and(cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)), gate)
     chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
-    _, w_y = cv2.threshold(chroma, CHROMA_FLOOR - 1, 0, cv2.THRESH_TOZERO)  # neutral pixels' chroma noise: 0
+    core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
+    count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
+    total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
+    ref = (total / np.maximum(count, 1.0)).astype(np.float32)[:, None]
+    floor = np.float32(CHROMA_FLOOR) * ref
+    w_y = chroma.reshape(n, h * w).astype(np.float32)
+    w_y -= floor
+    w_y /= np.maximum(ref - floor, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
+    np.clip(w_y, 0.0, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
     return w_x.reshape(n, h, w), w_y.reshape(n, h, w)
 
 
