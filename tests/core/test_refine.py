@@ -19,7 +19,7 @@ def test_horizontal_weights_ramp_with_saturation_and_respect_hue():
     hsv[0, 0, :, 0] = (0, 0, 0, 60)  # last pixel green
     hsv[0, 0, :, 1] = (40, 90, 200, 255)
     hsv[0, 0, :, 2] = 200
-    w_x, w_y = band_weights(hsv, 1, CFG)
+    w_x, w_y, _ = band_weights(hsv, 1, CFG)
     assert w_x.dtype == np.uint8 and w_y.dtype == np.float32
     assert (w_x[0, 0] / 255).tolist() == pytest.approx([0.0, 0.5, 1.0, 0.0], abs=0.01)
     assert w_y[0, 0, 3] == 0.0
@@ -27,7 +27,11 @@ def test_horizontal_weights_ramp_with_saturation_and_respect_hue():
 
 def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
     column = [WHITE, (RED + WHITE) / 2, RED, RED, RED, (RED + BLACK) / 2, BLACK]
-    _, w_y = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), 1, CFG)
+    _, w_y, ref = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), 1, CFG)
+    # mean chroma (max − min) of the saturated pixels: three reds at 160 and both half blends at 80
+    assert ref[0] == pytest.approx((3 * 160 + 2 * 80) / 5, abs=1)
+    again = band_weights(tiles(np.array(column).reshape(-1, 1, 3)), 1, CFG, refs=ref)[1]
+    assert np.array_equal(again, w_y)  # a known chroma (tracking) gives the same weights
     w = w_y[0, :, 0]
     assert w[0] == 0.0 and w[6] == 0.0
     assert w[1] == pytest.approx(w[5], abs=0.03)  # symmetric, so the centroid stays at the band centre
@@ -38,9 +42,9 @@ def test_vertical_weights_count_half_blends_the_same_against_white_and_black():
 def test_each_tile_uses_its_own_hue():
     red_tile = np.full((3, 3, 3), RED)
     blue_tile = np.full((3, 3, 3), BLUE)
-    w_x, _ = band_weights(tiles(red_tile, blue_tile), 1, CFG)
+    w_x, _, _ = band_weights(tiles(red_tile, blue_tile), 1, CFG)
     assert w_x[0].min() > 230 and w_x[1].min() > 230
-    w_x, _ = band_weights(tiles(blue_tile, red_tile), 1, CFG)
+    w_x, _, _ = band_weights(tiles(blue_tile, red_tile), 1, CFG)
     assert w_x.max() == 0  # blue pixels in a red tile (and the reverse) weigh nothing
 
 

@@ -45,6 +45,8 @@ class BandCentroids:
     blue_bbox_px: BBox
     red_mass_px: float
     blue_mass_px: float
+    red_chroma: float
+    blue_chroma: float
 
     @property
     def width_px(self) -> float:
@@ -101,7 +103,18 @@ def refine(
     for rb, bb, fix in zip(red_boxes.tolist(), blue_boxes.tolist(), fixes):
         if fix is not None:
             red, blue = fix
-            found.append(BandCentroids(red.xy_px, blue.xy_px, tuple(rb), tuple(bb), red.mass_px, blue.mass_px))
+            found.append(
+                BandCentroids(
+                    red.xy_px,
+                    blue.xy_px,
+                    tuple(rb),
+                    tuple(bb),
+                    red.mass_px,
+                    blue.mass_px,
+                    red.chroma_ref,
+                    blue.chroma_ref,
+                )
+            )
     return found
 
 
@@ -118,4 +131,4 @@ def detect_paper(bgr: np.ndarray, cfg: DetectionConfig) -> List[BandCentroids]:
         return []
     side = float(np.sqrt(red[2]))  # the paper has no band boxes: squares of the bands' areas
     boxes = [(int(c[0] - side / 2), int(c[1] - side / 4), int(side), int(side / 2)) for c in (red, blue)]
-    return [BandCentroids((red[0], red[1]), (blue[0], blue[1]), boxes[0], boxes[1], red[2], blue[2])]
+    return [BandCentroids((red[0], red[1]), (blue[0], blue[1]), boxes[0], boxes[1], red[2], blue[2], 0.0, 0.0)]

@@ -27,7 +27,9 @@ S_RAMP = 40  # saturation ramp half-width for the horizontal weights
 CHROMA_FLOOR = 0.15  # share of a band's mean chroma where its vertical weight starts
 
 
-def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.ndarray, np.ndarray]:
+def band_weights(
+    hsv: np.ndarray, n_red: int, cfg: DetectionConfig, refs: Optional[np.ndarray] = None
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W): ``w_x`` uint8 0–255, ``w_y`` float32 0–1.
 
     Parameters
@@ -36,6 +38,14 @@ def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.
         HSV tiles, one band each.
     n_red : int
         The first ``n_red`` tiles hold red bands, the rest blue ones.
+    refs : (N,) float array, optional
+        Each band's mean chroma if already known (tracking keeps it from the
+        last full scan); otherwise measured here.
+
+    Returns
+    -------
+    w_x, w_y, refs
+        The weights and each band's mean chroma.
 
     Notes
     -----
@@ -64,16 +74,18 @@ def band_weights(hsv: np.ndarray, n_red: int, cfg: DetectionConfig) -> Tuple[np.
     gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, min(cfg.v_min, 10)))
     w_x = cv2.bitwise_and(cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)), gate)
     chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
-    core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
-    count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
-    total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
-    ref = (total / np.maximum(count, 1.0)).astype(np.float32)[:, None]
+    if refs is None:
+        core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
+        count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
+        total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
+        refs = total / np.maximum(count, 1.0)
+    ref = np.asarray(refs, np.float32).reshape(n, 1)
     floor = np.float32(CHROMA_FLOOR) * ref
     w_y = chroma.reshape(n, h * w).astype(np.float32)
     w_y -= floor
     w_y /= np.maximum(ref - floor, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
     np.clip(w_y, 0.0, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
-    return w_x.reshape(n, h, w), w_y.reshape(n, h, w)
+    return w_x.reshape(n, h, w), w_y.reshape(n, h, w), ref[:, 0]
 
 
 def tile_centroids(w_x: np.ndarray, w_y: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -122,6 +134,7 @@ class BandFix:
 
     xy_px: XY
     mass_px: float
+    chroma_ref: float  # the band's mean chroma (S·V/255), the scale of its vertical weights
 
 
 def _band_region(shape: Tuple[int, ...], bbox: BBox, margin: Margin) -> Tuple[int, int, int, int, int]:
@@ -178,6 +191,7 @@ def measure_bands(
     cfg: DetectionConfig,
     gains: Gains,
     pyramid: Optional[Pyramid] = None,
+    refs: Optional[Sequence[float]] = None,
 ) -> List[Optional[BandFix]]:
     """Measure each band inside its box grown by its margin; ``None`` where nothing of its colour is left.
 
@@ -191,6 +205,8 @@ def measure_bands(
     pyramid : Pyramid, optional
         Downscaled copies of the frame to crop tall bands from; without it each
         tall band's region is resized on its own (the same pixels either way).
+    refs : sequence of float, optional
+        Each band's mean chroma when known (see :func:`band_weights`).
 
     Returns
     -------
@@ -217,12 +233,14 @@ def measure_bands(
         tile[: crop.shape[0], : crop.shape[1]] = crop
     _blank_neighbours(stack, regions, [boxes[k] for k in order], [is_red[k] for k in order])
     hsv = to_hsv(apply_gains(stack.reshape(-1, tw, 3), gains)).reshape(stack.shape)
-    x, y, mass, ok = tile_centroids(*band_weights(hsv, sum(1 for r in is_red if r), cfg))
+    ordered_refs = None if refs is None else np.asarray(refs, np.float32)[order]
+    w_x, w_y, band_refs = band_weights(hsv, sum(1 for r in is_red if r), cfg, ordered_refs)
+    x, y, mass, ok = tile_centroids(w_x, w_y)
     out: List[Optional[BandFix]] = [None] * len(boxes)
     for j, (k, (x0, y0, _, _, f)) in enumerate(zip(order, regions)):
         if ok[j]:
             xy = (x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5)
-            out[k] = BandFix(xy, float(mass[j]) * f * f / 255.0)  # w_x is 0–255
+            out[k] = BandFix(xy, float(mass[j]) * f * f / 255.0, float(band_refs[j]))  # w_x is 0–255
     return out
 
 

@@ -77,6 +77,8 @@ def advance(old: Track, red: BandFix, blue: BandFix) -> Track:
         _moved(b.blue_bbox_px, bdx, bdy),
         red.mass_px,
         blue.mass_px,
+        b.red_chroma,
+        b.blue_chroma,
     )
     return Track(bands, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
 
@@ -91,9 +93,12 @@ def step(
 ) -> Tuple[List[Track], bool]:
     """Follow every track into this frame; returns the surviving tracks and whether any was lost."""
     boxes: List[BBox] = []
+    refs: List[float] = []
     for t in tracks:
         boxes.extend(search_boxes(t))
-    fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), [motion_margin(b) for b in boxes], cfg, gains)
+        refs.extend((t.bands.red_chroma, t.bands.blue_chroma))  # kept from the last full scan
+    margins = [motion_margin(b) for b in boxes]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), margins, cfg, gains, refs=refs)
     kept: List[Track] = []
     lost = False
     for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2]):
