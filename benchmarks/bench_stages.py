@@ -66,7 +66,7 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             gains = grey_world_gains(cv2.resize(frame, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST))
             laps.lap("grey_world_gains (1/8 thumbnail)")
             small = downscale(frame, s)
-            laps.lap(f"downscale 1/{s} (INTER_AREA)")
+            laps.lap(f"downscale 1/{s} (2×2 average)")
             balanced = apply_gains(small, gains)
             laps.lap("region_masks: apply_gains")
             hsv = to_hsv(balanced)

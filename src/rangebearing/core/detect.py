@@ -31,7 +31,7 @@ from .blobs import find_boxes, mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
-from .refine import Pyramid, refine_pairs
+from .refine import Pyramid, half_or_area, refine_pairs
 from .types import XY, BBox, union
 
 
@@ -62,7 +62,7 @@ def downscale(bgr: np.ndarray, s: int) -> np.ndarray:
     if s == 1:
         return bgr
     h, w = bgr.shape[:2]
-    return cv2.resize(bgr[: h // s * s, : w // s * s], (w // s, h // s), interpolation=cv2.INTER_AREA)
+    return cv2.resize(bgr[: h // s * s, : w // s * s], (w // s, h // s), interpolation=half_or_area(s))
 
 
 def region_masks(small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:

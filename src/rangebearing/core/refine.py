@@ -102,6 +102,12 @@ def tile_centroids(w_x: np.ndarray, w_y: np.ndarray) -> Tuple[np.ndarray, np.nda
 Margin = Tuple[int, int]  # grow a band's box by (x, y) pixels on each side
 
 
+def half_or_area(f: int) -> int:
+    """The OpenCV interpolation for an f-fold area average: at exactly ½ bilinear
+    samples each 2×2 block's centre, which is the same average, computed faster."""
+    return cv2.INTER_LINEAR if f == 2 else cv2.INTER_AREA
+
+
 class Pyramid:
     """Area-averaged copies of one frame at ½, ¼, ⅛, made on demand and kept for the frame.
 
@@ -119,7 +125,7 @@ class Pyramid:
             finer = self.level(f // 2)
             h, w = finer.shape[:2]
             self._levels[f] = cv2.resize(
-                finer[: h // 2 * 2, : w // 2 * 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA
+                finer[: h // 2 * 2, : w // 2 * 2], (w // 2, h // 2), interpolation=cv2.INTER_LINEAR
             )
         return self._levels[f]
 
@@ -223,9 +229,9 @@ def measure_bands(
             crops.append(bgr[y0:y1, x0:x1])
         elif pyramid is not None:
             crops.append(pyramid.level(f)[y0 // f : y1 // f, x0 // f : x1 // f])
-        else:  # at exactly ½ bilinear is the 2×2 box average, and cheaper than INTER_AREA
-            interp = cv2.INTER_LINEAR if f == 2 else cv2.INTER_AREA
-            crops.append(cv2.resize(bgr[y0:y1, x0:x1], ((x1 - x0) // f, (y1 - y0) // f), interpolation=interp))
+        else:
+            roi = bgr[y0:y1, x0:x1]
+            crops.append(cv2.resize(roi, ((x1 - x0) // f, (y1 - y0) // f), interpolation=half_or_area(f)))
     th = max(c.shape[0] for c in crops)
     tw = max(c.shape[1] for c in crops)
     stack = np.zeros((len(crops), th, tw, 3), np.uint8)
