@@ -13,7 +13,6 @@ import statistics
 import time
 from typing import Dict, List, Sequence, Tuple
 
-import cv2
 import numpy as np
 
 from rangebearing import Config, Pipeline
@@ -50,7 +49,6 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
     from rangebearing.core.refine import Pyramid
 
     det, geom, cam = cfg.detection, cfg.landmark, cfg.camera
-    h, w = frames[0].shape[:2]
     s = det.downscale
     band_px = cam.fy_px * geom.band_height_m / cfg.model.envelope_range_m[1] / s
     ksize = band_preserving_ksize(det.median_ksize, band_px)
@@ -63,10 +61,10 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             laps = Laps()
         for frame in frames:
             laps.start()
-            gains = grey_world_gains(cv2.resize(frame, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST))
-            laps.lap("grey_world_gains (1/8 thumbnail)")
             small = downscale(frame, s)
             laps.lap(f"downscale 1/{s} (2×2 average)")
+            gains = grey_world_gains(small)
+            laps.lap("grey_world_gains (downscaled frame)")
             balanced = apply_gains(small, gains)
             laps.lap("region_masks: apply_gains")
             hsv = to_hsv(balanced)

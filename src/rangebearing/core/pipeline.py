@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from typing import Dict, List, Optional, Tuple
 
-import cv2
 import numpy as np
 
 from ..config import Config
@@ -100,10 +99,9 @@ class Pipeline:
                 found = [t.bands for t in self._tracks]
                 tracked = True
             else:
-                if det.white_balance == "grey_world":
-                    thumb = cv2.resize(bgr, (w // 8, h // 8), interpolation=cv2.INTER_NEAREST)
-                    self._gains = grey_world_gains(thumb)
                 small = downscale(bgr, det.downscale)
+                if det.white_balance == "grey_world":
+                    self._gains = grey_world_gains(small)
                 reds, blues = find_pairs(small, det, self._gains, ksize, self.limits, self.cfg.landmark)
                 found = refine(bgr, reds, blues, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
                 self._tracks = [Track(c) for c in found] if self.track else []
