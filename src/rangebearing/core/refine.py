@@ -165,7 +165,8 @@ def _blank_neighbours(
     Landmarks side by side put each other's bands inside their measuring
     windows; a neighbour's band would pull the centroid towards it.
     """
-    if len(boxes) < 2:
+    n_red = sum(1 for r in is_red if r)
+    if n_red < 2 and len(is_red) - n_red < 2:  # no two bands of one colour: nothing to blank
         return
     b = np.asarray(boxes, np.int64)
     bx0, by0 = b[:, 0] - 1, b[:, 1] - 1
