@@ -8,7 +8,7 @@ import sys
 from typing import Iterable, Iterator, Optional, TypeVar
 
 from ..config import Config, load_config
-from ..core.types import Landmark
+from ..net.protocol import LandmarkLike
 
 T = TypeVar("T")
 
@@ -38,7 +38,7 @@ def progress(items: Iterable[T], total: Optional[int], label: str, enabled: Opti
         sys.stderr.write("\n")
 
 
-def describe(lm: Landmark) -> str:
-    """One landmark as ``0.412 m  +12.3°`` (with a note when outside the envelope)."""
+def describe(lm: LandmarkLike) -> str:
+    """One landmark, seen here or received, as ``0.412 m  +12.3°`` (noted when outside the envelope)."""
     note = "" if lm.in_envelope else " (out of envelope)"
-    return f"{lm.range_m:.3f} m {math.degrees(lm.bearing_rad):+6.2f}°{note}"
+    return f"{lm.range_m:.3f} m  {math.degrees(lm.bearing_rad):+.1f}°{note}"

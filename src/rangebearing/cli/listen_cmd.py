@@ -12,6 +12,7 @@ from typing import Any, Optional, TextIO
 from ..config import DEFAULT_PORT
 from ..net.client import Subscriber
 from ..net.protocol import Reading
+from .common import describe
 
 DESCRIPTION = """\
 Listen for rangebearing readings and print one line per frame:
@@ -76,10 +77,7 @@ def format_reading(reading: Reading) -> str:
     """One human-readable line for one reading."""
     n = len(reading.landmarks)
     head = f"{reading.robot} #{reading.seq} t={reading.t:.3f}  {n} landmark{'' if n == 1 else 's'}"
-    parts = []
-    for lm in reading.landmarks:
-        text = f"{lm.range_m:.3f} m  {math.degrees(lm.bearing_rad):+.1f}°"
-        parts.append(text if lm.in_envelope else f"{text} (out of envelope)")
+    parts = [describe(lm) for lm in reading.landmarks]
     line = f"{head}: {' | '.join(parts)}" if parts else head
     extras = []
     if reading.fps is not None:

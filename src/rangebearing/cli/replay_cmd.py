@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
                 }
                 out.write(json.dumps(rec, separators=(",", ":")) + "\n")
             if not args.quiet:
-                print(f"{name}: " + ("  |  ".join(describe(lm) for lm in result.landmarks) or "-"), flush=True)
+                print(f"{name}: " + (" | ".join(describe(lm) for lm in result.landmarks) or "-"), flush=True)
             if ann_dir:
                 stem = Path(name).stem if not is_video else f"{int(name):06d}"
                 cv2.imwrite(str(ann_dir / f"{stem}.png"), annotate(image, result))
