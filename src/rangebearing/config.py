@@ -14,6 +14,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Tuple, Union
 
 import yaml
 
+from . import config_checks as ck
 from ._compat import frozen
 from .core.types import CameraIntrinsics, LandmarkGeometry
 from .errors import ConfigError
@@ -117,204 +118,88 @@ class Config:
     source_file: str = "<defaults>"
 
 
-# --- per-key checks ---------------------------------------------------------
-# A check takes the raw YAML value and returns the normalised value or raises
-# ValueError with a short reason.
-
-Check = Callable[[Any], Any]
-
-
-def _number(lo: float = -math.inf, hi: float = math.inf, integer: bool = False) -> Check:
-    def check(v: Any) -> Any:
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise ValueError(f"expected a number, got {v!r}")
-        if integer and not float(v).is_integer():
-            raise ValueError(f"expected an integer, got {v!r}")
-        if not math.isfinite(v) or not lo <= v <= hi:
-            raise ValueError(f"{v!r} is outside [{lo}, {hi}]")
-        return int(v) if integer else float(v)
-
-    return check
-
-
-def _positive(integer: bool = False) -> Check:
-    inner = _number(0, math.inf, integer)
-
-    def check(v: Any) -> Any:
-        out = inner(v)
-        if out <= 0:
-            raise ValueError(f"must be > 0, got {v!r}")
-        return out
-
-    return check
-
-
-def _bool(v: Any) -> bool:
-    if not isinstance(v, bool):
-        raise ValueError(f"expected true or false, got {v!r}")
-    return v
-
-
-def _choice(*choices: str) -> Check:
-    def check(v: Any) -> str:
-        if v not in choices:
-            raise ValueError(f"{v!r} is not one of {', '.join(choices)}")
-        return str(v)
-
-    return check
-
-
-def _string(v: Any) -> str:
-    if isinstance(v, bool) or not isinstance(v, (str, int)):
-        raise ValueError(f"expected a string, got {v!r}")
-    return str(v)
-
-
-def _odd_ksize(v: Any) -> int:
-    n = _number(1, 99, integer=True)(v)
-    if n % 2 == 0:
-        raise ValueError(f"must be odd, got {n}")
-    return int(n)
-
-
-def _pair(lo: float, hi: float, integer: bool = False, ordered: bool = True) -> Check:
-    num = _number(lo, hi, integer)
-
-    def check(v: Any) -> Tuple[Any, Any]:
-        if not isinstance(v, (list, tuple)) or len(v) != 2:
-            raise ValueError(f"expected a pair [low, high], got {v!r}")
-        a, b = num(v[0]), num(v[1])
-        if ordered and a > b:
-            raise ValueError(f"low {a} is above high {b}")
-        return (a, b)
-
-    return check
-
-
-def _hue_ranges(v: Any) -> Tuple[Tuple[int, int], ...]:
-    if isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, int) for x in v):
-        v = [v]
-    if not isinstance(v, (list, tuple)) or not v:
-        raise ValueError(f"expected a list of [low, high] hue ranges (0-179), got {v!r}")
-    return tuple(_pair(0, 179, integer=True)(r) for r in v)
-
-
-def _distortion(v: Any) -> Tuple[float, ...]:
-    if not isinstance(v, (list, tuple)) or len(v) not in (4, 5, 8):
-        raise ValueError(f"expected 4, 5 or 8 OpenCV coefficients, got {v!r}")
-    return tuple(_number()(c) for c in v)
-
-
-def _host_port(v: Any) -> Tuple[str, int]:
-    if isinstance(v, str) and v.rpartition(":")[0]:
-        host, _, port = v.rpartition(":")
-        return (host.strip("[]"), _number(1, 65535, integer=True)(int(port) if port.isdigit() else port))
-    raise ValueError(f"expected 'host:port', got {v!r}")
-
-
-def _destinations(v: Any) -> Tuple[Tuple[str, int], ...]:
-    if not isinstance(v, (list, tuple)):
-        raise ValueError(f"expected a list of 'host:port', got {v!r}")
-    return tuple(_host_port(d) for d in v)
-
-
-def _controls(v: Any) -> Tuple[Tuple[str, Any], ...]:
-    if v is None:
-        return ()
-    if not isinstance(v, Mapping):
-        raise ValueError(f"expected a mapping of Picamera2 control names to values, got {v!r}")
-    out = []
-    for key, val in v.items():
-        if not isinstance(key, str) or not key[:1].isupper():
-            raise ValueError(f"control name {key!r} should be a libcamera control such as AeEnable")
-        if isinstance(val, list):
-            val = tuple(val)
-        out.append((key, val))
-    return tuple(out)
-
-
-SCHEMA: Dict[str, Tuple[type, Dict[str, Check]]] = {
+SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
     "camera": (
         CameraIntrinsics,
         {
-            "width_px": _positive(True),
-            "height_px": _positive(True),
-            "fx_px": _positive(),
-            "fy_px": _positive(),
-            "cx_px": _number(0, 10000),
-            "cy_px": _number(0, 10000),
-            "distortion": _distortion,
+            "width_px": ck.positive(True),
+            "height_px": ck.positive(True),
+            "fx_px": ck.positive(),
+            "fy_px": ck.positive(),
+            "cx_px": ck.number(0, 10000),
+            "cy_px": ck.number(0, 10000),
+            "distortion": ck.distortion,
         },
     ),
     "landmark": (
         LandmarkGeometry,
         {
-            "height_m": _positive(),
-            "diameter_m": _positive(),
-            "band_height_m": _positive(),
+            "height_m": ck.positive(),
+            "diameter_m": ck.positive(),
+            "band_height_m": ck.positive(),
         },
     ),
     "detection": (
         DetectionConfig,
         {
-            "method": _choice(*METHODS),
-            "median_ksize": _odd_ksize,
-            "downscale": _number(1, 4, integer=True),
-            "white_balance": _choice(*WHITE_BALANCE),
-            "red_hue": _hue_ranges,
-            "blue_hue": _hue_ranges,
-            "s_min": _number(0, 255, integer=True),
-            "v_min": _number(0, 255, integer=True),
-            "min_band_px": _number(1, 100),
-            "max_landmarks": _positive(True),
-            "tracking": _bool,
-            "full_scan_every": _positive(True),
+            "method": ck.choice(*METHODS),
+            "median_ksize": ck.odd_ksize,
+            "downscale": ck.number(1, 4, integer=True),
+            "white_balance": ck.choice(*WHITE_BALANCE),
+            "red_hue": ck.hue_ranges,
+            "blue_hue": ck.hue_ranges,
+            "s_min": ck.number(0, 255, integer=True),
+            "v_min": ck.number(0, 255, integer=True),
+            "min_band_px": ck.number(1, 100),
+            "max_landmarks": ck.positive(True),
+            "tracking": ck.boolean,
+            "full_scan_every": ck.positive(True),
         },
     ),
     "model": (
         ModelConfig,
         {
-            "kind": _choice(*MODELS),
-            "spacing_m": _positive(),
-            "c_m": _number(-0.5, 0.5),
-            "k_px_m": _positive(),
-            "kh_m_per_px": _positive(),
-            "cylinder_correction": _bool,
-            "envelope_range_m": _pair(0, 100),
-            "envelope_bearing_rad": _pair(-math.pi, math.pi),
+            "kind": ck.choice(*MODELS),
+            "spacing_m": ck.positive(),
+            "c_m": ck.number(-0.5, 0.5),
+            "k_px_m": ck.positive(),
+            "kh_m_per_px": ck.positive(),
+            "cylinder_correction": ck.boolean,
+            "envelope_range_m": ck.pair(0, 100),
+            "envelope_bearing_rad": ck.pair(-math.pi, math.pi),
         },
     ),
     "source": (
         SourceConfig,
         {
-            "kind": _choice(*SOURCES),
-            "path": _string,
-            "fps": _number(0, 1000),
-            "loop": _bool,
-            "device": _string,
-            "camera_num": _number(0, 16, integer=True),
-            "width_px": _positive(True),
-            "height_px": _positive(True),
-            "hflip": _bool,
-            "vflip": _bool,
-            "buffer_count": _number(1, 16, integer=True),
-            "timeout_s": _positive(),
-            "retries": _number(0, 1000, integer=True),
-            "controls": _controls,
+            "kind": ck.choice(*SOURCES),
+            "path": ck.string,
+            "fps": ck.number(0, 1000),
+            "loop": ck.boolean,
+            "device": ck.string,
+            "camera_num": ck.number(0, 16, integer=True),
+            "width_px": ck.positive(True),
+            "height_px": ck.positive(True),
+            "hflip": ck.boolean,
+            "vflip": ck.boolean,
+            "buffer_count": ck.number(1, 16, integer=True),
+            "timeout_s": ck.positive(),
+            "retries": ck.number(0, 1000, integer=True),
+            "controls": ck.controls,
         },
     ),
     "publish": (
         PublishConfig,
         {
-            "robot_id": _string,
-            "unicast": _destinations,
-            "multicast_group": _string,
-            "multicast_port": _number(1, 65535, integer=True),
-            "multicast_ttl": _number(0, 255, integer=True),
-            "multicast_interface": _string,
+            "robot_id": ck.string,
+            "unicast": ck.destinations,
+            "multicast_group": ck.string,
+            "multicast_port": ck.number(1, 65535, integer=True),
+            "multicast_ttl": ck.number(0, 255, integer=True),
+            "multicast_interface": ck.string,
         },
     ),
-    "daemon": (DaemonConfig, {"status_interval_s": _positive(), "echo": _bool}),
+    "daemon": (DaemonConfig, {"status_interval_s": ck.positive(), "echo": ck.boolean}),
 }
 
 
