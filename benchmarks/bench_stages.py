@@ -81,7 +81,7 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
             centroids = refine(
                 frame, reds[idx[:, 0]], blues[idx[:, 1]], det, gains, Pyramid(frame, small if s == 2 else None)
             )
-            laps.lap("refine_pairs (detect.refine)")
+            laps.lap("refine (sub-pixel moments)")
             for c in centroids:
                 rng, bearing, *_ = reading(c.red_xy_px, c.blue_xy_px, cam, cfg.model, geom)
                 in_envelope(rng, bearing, cfg.model)

@@ -3,7 +3,8 @@ import pytest
 
 from rangebearing.config import DetectionConfig
 from rangebearing.core.color import to_hsv
-from rangebearing.core.refine import band_weights, measure_bands, refine_pairs, tile_centroids
+from rangebearing.core.detect import refine
+from rangebearing.core.refine import band_weights, measure_bands, tile_centroids
 
 CFG = DetectionConfig()
 RED, BLUE = np.array([40, 40, 200.0]), np.array([200, 60, 30.0])
@@ -63,14 +64,15 @@ def boxes(*b):
 
 
 @pytest.mark.parametrize("scale_rows", [6, 30])  # small bands at full resolution, tall ones at 1/f
-def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_rows):
+def test_refine_finds_rectangle_centres_in_full_resolution_pixels(scale_rows):
     img = np.full((200, 160, 3), 220, np.uint8)
     h = scale_rows
     img[20 : 20 + h, 40:80] = RED
     img[100 : 100 + h, 42:82] = BLUE
-    red, blue = refine_pairs(img, boxes((40, 20, 40, h)), boxes((42, 100, 40, h)), CFG, (1.0, 1.0, 1.0))[0]
-    (rx, ry), (bx, by) = red.xy_px, blue.xy_px
-    assert red.mass_px == pytest.approx(40 * h, rel=0.1)  # the weight is about the band area
+    (found,) = refine(img, boxes((40, 20, 40, h)), boxes((42, 100, 40, h)), CFG, (1.0, 1.0, 1.0))
+    (rx, ry), (bx, by) = found.red_xy_px, found.blue_xy_px
+    assert found.red_mass_px == pytest.approx(40 * h, rel=0.1)  # the weight is about the band area
+    assert found.bbox_px == (40, 20, 42, 100 + h - 20)
     # y weights are linear in coverage: exact. x weights ramp with saturation, which is not
     # linear in coverage, so a band edge that half-fills a downscaled pixel shifts x a little.
     x_tol = 0.05 if h < 16 else 0.3
@@ -78,11 +80,11 @@ def test_refine_pairs_finds_rectangle_centres_in_full_resolution_pixels(scale_ro
     assert rx == pytest.approx(59.5, abs=x_tol) and bx == pytest.approx(61.5, abs=x_tol)
 
 
-def test_a_pair_whose_band_vanished_gives_none():
+def test_a_candidate_whose_band_vanished_is_dropped():
     img = np.full((100, 100, 3), 220, np.uint8)
     img[10:16, 10:40] = RED  # no blue anywhere
-    assert refine_pairs(img, boxes((10, 10, 30, 6)), boxes((10, 50, 30, 6)), CFG, (1.0, 1.0, 1.0)) == [None]
-    assert refine_pairs(img, boxes(), boxes(), CFG, (1.0, 1.0, 1.0)) == []
+    assert refine(img, boxes((10, 10, 30, 6)), boxes((10, 50, 30, 6)), CFG, (1.0, 1.0, 1.0)) == []
+    assert refine(img, boxes(), boxes(), CFG, (1.0, 1.0, 1.0)) == []
 
 
 def test_a_neighbouring_band_inside_the_window_does_not_pull_the_centroid():

@@ -31,7 +31,7 @@ from .blobs import find_boxes, mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
-from .refine import Pyramid, half_or_area, refine_pairs
+from .refine import Pyramid, half_or_area, measure_bands
 from .types import XY, BBox, union
 
 
@@ -97,23 +97,21 @@ def refine(
     gains: Gains,
     pyramid: Optional[Pyramid] = None,
 ) -> List[BandCentroids]:
-    """Sub-pixel centroids of every candidate (one batch); candidates whose bands vanish are dropped."""
+    """Sub-pixel centroids of every candidate, all bands in one batch; candidates whose band vanished are dropped.
+
+    Row k of ``red_boxes`` and of ``blue_boxes`` (full-resolution x, y, w, h)
+    belong to candidate k. Each band is measured inside its box grown by
+    ``downscale + 1`` px, which covers the downscaling and the filter's erosion.
+    """
+    m = cfg.downscale + 1
+    reds, blues = [tuple(b) for b in red_boxes.tolist()], [tuple(b) for b in blue_boxes.tolist()]
+    boxes = [b for pair in zip(reds, blues) for b in pair]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(reds), [(m, m)] * len(boxes), cfg, gains, pyramid)
     found = []
-    fixes = refine_pairs(bgr, red_boxes, blue_boxes, cfg, gains, pyramid)
-    for rb, bb, fix in zip(red_boxes.tolist(), blue_boxes.tolist(), fixes):
-        if fix is not None:
-            red, blue = fix
+    for rb, bb, red, blue in zip(reds, blues, fixes[0::2], fixes[1::2]):
+        if red is not None and blue is not None:
             found.append(
-                BandCentroids(
-                    red.xy_px,
-                    blue.xy_px,
-                    tuple(rb),
-                    tuple(bb),
-                    red.mass_px,
-                    blue.mass_px,
-                    red.chroma_ref,
-                    blue.chroma_ref,
-                )
+                BandCentroids(red.xy_px, blue.xy_px, rb, bb, red.mass_px, blue.mass_px, red.chroma_ref, blue.chroma_ref)
             )
     return found
 

@@ -249,26 +249,3 @@ def measure_bands(
             xy = (x0 + (float(x[j]) + 0.5) * f - 0.5, y0 + (float(y[j]) + 0.5) * f - 0.5)
             out[k] = BandFix(xy, float(mass[j]) * f * f / 255.0, float(band_refs[j]))  # w_x is 0–255
     return out
-
-
-def refine_pairs(
-    bgr: np.ndarray,
-    red_boxes: np.ndarray,
-    blue_boxes: np.ndarray,
-    cfg: DetectionConfig,
-    gains: Gains,
-    pyramid: Optional[Pyramid] = None,
-) -> List[Optional[Tuple[BandFix, BandFix]]]:
-    """Measure the red and blue band of each candidate (one batch); ``None`` where a band vanished.
-
-    Row k of ``red_boxes`` and of ``blue_boxes`` (full-resolution x, y, w, h)
-    belong to candidate k. Each band is measured inside its box grown by ``downscale + 1`` px,
-    which covers the downscaling and the majority filter's erosion.
-    """
-    m = cfg.downscale + 1
-    boxes = [tuple(b) for pair in zip(red_boxes.tolist(), blue_boxes.tolist()) for b in pair]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(red_boxes), [(m, m)] * len(boxes), cfg, gains, pyramid)
-    out: List[Optional[Tuple[BandFix, BandFix]]] = []
-    for red, blue in zip(fixes[0::2], fixes[1::2]):
-        out.append(None if red is None or blue is None else (red, blue))
-    return out
