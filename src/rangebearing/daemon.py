@@ -15,11 +15,11 @@ import logging
 import signal
 import threading
 import time
-from typing import Callable, Optional, TextIO, Tuple
+from typing import Callable, Optional, TextIO
 
 from .config import Config, SourceConfig, load_config
 from .core.pipeline import Pipeline
-from .errors import ConfigError, FrameError, ProtocolError, SourceError
+from .errors import ConfigError, FrameError, ProtocolError, RangeBearingError, SourceError
 from .net.protocol import encode_reading
 from .net.publisher import Publisher
 from .sdnotify import Notifier
@@ -75,6 +75,9 @@ class Daemon:
         self._stop = threading.Event()
         self._reload = threading.Event()
         self._source: Optional[FrameSource] = None
+        self._pipe = Pipeline(cfg)
+        self._publisher: Optional[Publisher] = None
+        self._ready = False  # READY=1 sent: the first frame went through
         self._dropped_before = 0  # drops of sources closed by a reload
 
     # --- control, safe to call from signal handlers ---------------------------------
@@ -99,11 +102,11 @@ class Daemon:
     # --- the loop ---------------------------------------------------------------------
     def run(self) -> int:
         """Returns 0 when the source ends or a stop was requested, 1 when the source failed."""
-        pipe = Pipeline(self.cfg)
-        publisher = self._open_publisher(self.cfg)
+        self._pipe = Pipeline(self.cfg)
+        self._publisher = self._open_publisher(self.cfg)
         try:
             self._source = self._open_source(self.cfg, self._stop.wait)
-            return self._loop(pipe, publisher)
+            return self._loop()
         except SourceError as exc:
             log.error("frame source failed: %s", exc)
             return 1
@@ -111,24 +114,24 @@ class Daemon:
             self.notifier.stopping()
             if self._source is not None:
                 self._source.close()
-            publisher.close()
+            self._publisher.close()
             log.info("stopped: %s", self.summary().line())
 
-    def _loop(self, pipe: Pipeline, publisher: Publisher) -> int:
+    def _loop(self) -> int:
         clock = time.monotonic_ns
-        ready = False
         wd = self.notifier.watchdog_interval_s()
         wd_every_ns = int(wd * 1e9 / 2) if wd else 0
         last_wd = last_status = clock()
         seq = 0
+        source, pipe, publisher = self._source, self._pipe, self._publisher
         while not self._stop.is_set():
             if self._reload.is_set():
                 self._reload.clear()
-                pipe, publisher = self._do_reload(pipe, publisher)
-            assert self._source is not None
+                self._do_reload()
+                source, pipe, publisher = self._source, self._pipe, self._publisher
             t_read = clock()
             try:
-                frame = self._source.read()
+                frame = source.read()
                 if frame is None:
                     log.info("end of stream")
                     return 0
@@ -156,10 +159,10 @@ class Daemon:
                 {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1},
             )
             if self.echo:
-                self.echo(payload)
-            if not ready:
+                self._echo(payload)
+            if not self._ready:
                 self.notifier.ready()
-                ready = True
+                self._ready = True
                 log.info("ready: first frame processed (%d×%d)", frame.image.shape[1], frame.image.shape[0])
             if wd_every_ns and t2 - last_wd >= wd_every_ns:
                 self.notifier.watchdog()  # only while frames flow: a stuck camera ends in a restart
@@ -171,6 +174,14 @@ class Daemon:
                 last_status = t2
         return 0
 
+    def _echo(self, payload: bytes) -> None:
+        """Show a sent reading; a closed terminal or pipe stops the echo, not the daemon."""
+        try:
+            self.echo(payload)  # type: ignore[misc]
+        except (OSError, RangeBearingError) as exc:
+            log.warning("echo stopped: %s", exc)
+            self.echo = None
+
     def _bad_frame(self, what: str, exc: Exception) -> None:
         """Count a skipped frame; log the first three, then every hundredth (no flooding the journal)."""
         self.stats.bad_frames += 1
@@ -178,38 +189,51 @@ class Daemon:
         if n <= 3 or n % 100 == 0:
             log.warning("%s (%d so far): %s", what, n, exc)
 
-    def _do_reload(self, pipe: Pipeline, publisher: Publisher) -> Tuple[Pipeline, Publisher]:
-        """Re-read the config file; keep everything as it was if the new one is bad."""
+    def _do_reload(self) -> None:
+        """Re-read the config file and swap it in; keep everything as it was if the new one is bad."""
         self.notifier.reloading()
         try:
             if not self.config_path:
                 log.warning("SIGHUP ignored: no --config file to reload")
-                return pipe, publisher
+                return
             try:
                 new = load_config(self.config_path)
-            except ConfigError as exc:
-                log.error("reload rejected, keeping the running config: %s", exc)
-                return pipe, publisher
-            if self.source_override is not None:  # a source given on the command line wins
-                new = dataclasses.replace(new, source=self.source_override)
-            try:
+                if self.source_override is not None:  # a source given on the command line wins
+                    new = dataclasses.replace(new, source=self.source_override)
                 new_pub = self._open_publisher(new)
             except ConfigError as exc:
                 log.error("reload rejected, keeping the running config: %s", exc)
-                return pipe, publisher
-            publisher.close()
-            if new.source != self.cfg.source:
-                log.info("camera settings changed: reopening the frame source")
-                assert self._source is not None
-                self._dropped_before += self._source.dropped
-                self._source.close()
-                self._source = None
-                self._source = self._open_source(new, self._stop.wait)
-            self.cfg = new
+                return
+            if new.source != self.cfg.source and not self._swap_source(new):
+                new_pub.close()
+                return
+            self._publisher.close()
+            self._publisher, self._pipe, self.cfg = new_pub, Pipeline(new), new
             log.info("config reloaded from %s", self.config_path)
-            return Pipeline(new), new_pub
         finally:
-            self.notifier.ready()
+            if self._ready:
+                self.notifier.ready()
+
+    def _swap_source(self, new: Config) -> bool:
+        """Close the running source and open the new config's; on failure reopen the old one and say False.
+
+        The old source is closed first: a camera cannot be opened twice. If the
+        old one cannot be reopened either, SourceError ends the run (and systemd
+        restarts the service).
+        """
+        log.info("camera settings changed: reopening the frame source")
+        old = self._source
+        self._source = None
+        if old is not None:
+            self._dropped_before += old.dropped
+            old.close()
+        try:
+            self._source = self._open_source(new, self._stop.wait)
+            return True
+        except SourceError as exc:
+            log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
+            self._source = self._open_source(self.cfg, self._stop.wait)
+            return False
 
 
 def echo_to(stream: TextIO) -> Echo:
