@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Tuple, Union
+from typing import Any, List, Tuple, Union
 
 import cv2
 
@@ -15,6 +15,7 @@ from ..core.pipeline import Pipeline
 from ..core.types import Landmark
 from ..errors import FrameError, SourceError
 from ..evaluate import accuracy, format_report
+from ..net.protocol import landmark_fields
 from ..sources.recorded import count_recorded, iter_recorded
 from ..truth import read_truth
 from .common import add_config_arg, config_from_args, describe, progress
@@ -35,21 +36,6 @@ def register(sub: Any) -> None:
     p.add_argument("--track", action="store_true", help="treat the frames as a sequence and track landmarks")
     p.add_argument("-q", "--quiet", action="store_true", help="do not print a line per frame")
     p.set_defaults(func=run)
-
-
-def landmark_json(lm: Landmark) -> Dict[str, Any]:
-    """A landmark as plain JSON-ready values (the same names as the wire format)."""
-    return {
-        "range_m": round(lm.range_m, 5),
-        "bearing_rad": round(lm.bearing_rad, 6),
-        "in_envelope": lm.in_envelope,
-        "d_v_m": round(lm.d_v_m, 5),
-        "d_h_m": round(lm.d_h_m, 5),
-        "l_px": round(lm.l_px, 3),
-        "red_px": [round(v, 2) for v in lm.red_xy_px],
-        "blue_px": [round(v, 2) for v in lm.blue_xy_px],
-        "width_px": round(lm.width_px, 1),
-    }
 
 
 def run(args: argparse.Namespace) -> int:
@@ -78,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
             if out:
                 rec = {
                     "frame": key,
-                    "landmarks": [landmark_json(lm) for lm in result.landmarks],
+                    "landmarks": [landmark_fields(lm) for lm in result.landmarks],
                     "tracked": result.tracked,
                 }
                 out.write(json.dumps(rec, separators=(",", ":")) + "\n")

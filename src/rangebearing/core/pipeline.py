@@ -70,7 +70,12 @@ class Pipeline:
         if key not in self._cams:
             cam = self.cfg.camera
             if (cam.width_px, cam.height_px) != key:
-                cam = cam.scaled(w, h)
+                if abs(w * cam.height_px - h * cam.width_px) > 0.01 * w * cam.height_px:
+                    raise FrameError(
+                        f"frame is {w}×{h} but the camera intrinsics are for {cam.width_px}×{cam.height_px}, "
+                        "another aspect ratio (a cropped sensor mode): configure camera.* for this resolution"
+                    )
+                cam = cam.scaled(w, h)  # the same sensor area at another resolution
             far = self.cfg.model.envelope_range_m[1]
             band_px = cam.fy_px * self.cfg.landmark.band_height_m / far / self.cfg.detection.downscale
             self._cams[key] = (cam, band_preserving_ksize(self.cfg.detection.median_ksize, band_px))
@@ -106,7 +111,10 @@ class Pipeline:
                 found = refine(bgr, reds, blues, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
-        landmarks = sorted((self._landmark(c, cam) for c in found), key=lambda lm: lm.range_m)
+        # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close)
+        landmarks = sorted(
+            (lm for lm in map(self._landmark, found, [cam] * len(found)) if lm.range_m > 0), key=lambda lm: lm.range_m
+        )
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
 
     def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:

@@ -106,10 +106,12 @@ class Reading:
 # --- encoding ---------------------------------------------------------------
 
 
-def _num(x: Any, digits: int, what: str) -> float:
+def _num(x: Any, digits: int, what: str, lo: float = -math.inf, hi: float = math.inf) -> float:
     v = float(x)
     if not math.isfinite(v):
         raise ProtocolError(f"cannot encode {what}={v!r}: not a finite number")
+    if not lo <= v <= hi:  # the limits decode_reading enforces: never send what a consumer must drop
+        raise ProtocolError(f"cannot encode {what}={v!r}: outside [{lo:g}, {hi:g}]")
     return round(v, digits) + 0.0  # + 0.0 turns -0.0 into 0.0
 
 
@@ -126,6 +128,28 @@ def _count(n: Any, what: str) -> int:
 def _xy(p: Any, what: str) -> List[float]:
     x, y = p
     return [_num(x, PX_DIGITS, what), _num(y, PX_DIGITS, what)]
+
+
+def landmark_fields(lm: LandmarkLike) -> Dict[str, Any]:
+    """One landmark's wire fields, rounded and checked: what a datagram carries, and what
+    ``replay --out`` writes per landmark.
+
+    Raises
+    ------
+    ProtocolError
+        A value is not finite or is outside what :func:`decode_reading` accepts.
+    """
+    return {
+        "range_m": _num(lm.range_m, M_DIGITS, "range_m", lo=0.0),
+        "bearing_rad": _num(lm.bearing_rad, RAD_DIGITS, "bearing_rad", -math.pi, math.pi),
+        "in_envelope": bool(lm.in_envelope),
+        "l_px": _num(lm.l_px, PX_DIGITS, "l_px", lo=0.0),
+        "d_v_m": _num(lm.d_v_m, M_DIGITS, "d_v_m"),
+        "d_h_m": _num(lm.d_h_m, M_DIGITS, "d_h_m"),
+        "red_px": _xy(lm.red_xy_px, "red_px"),
+        "blue_px": _xy(lm.blue_xy_px, "blue_px"),
+        "width_px": _num(lm.width_px, PX_DIGITS, "width_px", lo=0.0),
+    }
 
 
 def encode_reading(
@@ -167,15 +191,8 @@ def encode_reading(
         raise ProtocolError(f"robot id must be a non-empty string, got {robot!r}")
     cols: Dict[str, List[Any]] = {name: [] for name in LANDMARK_FIELDS}
     for lm in landmarks:
-        cols["range_m"].append(_num(lm.range_m, M_DIGITS, "range_m"))
-        cols["bearing_rad"].append(_num(lm.bearing_rad, RAD_DIGITS, "bearing_rad"))
-        cols["in_envelope"].append(bool(lm.in_envelope))
-        cols["l_px"].append(_num(lm.l_px, PX_DIGITS, "l_px"))
-        cols["d_v_m"].append(_num(lm.d_v_m, M_DIGITS, "d_v_m"))
-        cols["d_h_m"].append(_num(lm.d_h_m, M_DIGITS, "d_h_m"))
-        cols["red_px"].append(_xy(lm.red_xy_px, "red_px"))
-        cols["blue_px"].append(_xy(lm.blue_xy_px, "blue_px"))
-        cols["width_px"].append(_num(lm.width_px, PX_DIGITS, "width_px"))
+        for name, value in landmark_fields(lm).items():
+            cols[name].append(value)
     msg: Dict[str, Any] = {
         "v": PROTOCOL_VERSION,
         "robot": robot,

@@ -1,0 +1,57 @@
+import dataclasses
+import re
+
+import numpy as np
+import pytest
+
+from rangebearing import FrameError, Pipeline, load_config
+from rangebearing.synth import LandmarkPose, Scene, render
+
+SCENE = Scene(landmarks=(LandmarkPose(0.4, 0.1),), wall_distance_m=2.0)
+
+
+@pytest.mark.parametrize(
+    "frame, message",
+    [
+        (None, "not a numpy array"),
+        (np.zeros((480, 640), np.uint8), "expected (height, width, 3)"),
+        (np.zeros((480, 640, 3), np.float32), "dtype float32"),
+        (np.zeros((4, 4, 3), np.uint8), "too small"),
+        (np.zeros((720, 1280, 3), np.uint8), "another aspect ratio"),
+    ],
+)
+def test_unusable_frames_raise_frame_error(frame, message):
+    with pytest.raises(FrameError, match=re.escape(message)):
+        Pipeline(load_config(None)).process(frame)
+
+
+def test_an_empty_scene_gives_no_landmarks():
+    assert Pipeline(load_config(None)).process(render(Scene(wall_distance_m=2.0))).landmarks == ()
+
+
+def test_a_smaller_frame_of_the_same_camera_reads_the_same():
+    img = render(SCENE)
+    small = img.reshape(240, 2, 320, 2, 3).mean(axis=(1, 3)).round().astype(np.uint8)
+    a = Pipeline(load_config(None)).process(img).landmarks[0]
+    b = Pipeline(load_config(None)).process(small).landmarks[0]
+    assert b.range_m == pytest.approx(a.range_m, rel=0.01)
+    assert b.bearing_rad == pytest.approx(a.bearing_rad, abs=0.002)
+
+
+def test_readings_with_no_positive_range_are_dropped():
+    cfg = load_config(None)
+    broken = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, c_m=-0.5))
+    assert Pipeline(cfg).process(render(SCENE)).landmarks[0].range_m == pytest.approx(0.4, rel=0.01)
+    assert Pipeline(broken).process(render(SCENE)).landmarks == ()
+
+
+def test_the_paper_method_finds_one_landmark_with_its_own_model():
+    cfg = load_config(None)
+    paper = dataclasses.replace(
+        cfg,
+        detection=dataclasses.replace(cfg.detection, method="paper"),
+        model=dataclasses.replace(cfg.model, kind="paper"),
+    )
+    (lm,) = Pipeline(paper).process(render(SCENE)).landmarks
+    assert lm.range_m == pytest.approx(0.4, rel=0.1)  # the paper's k = 35 px·m, uncalibrated
+    assert lm.bearing_rad > 0
