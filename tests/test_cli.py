@@ -88,3 +88,27 @@ def test_replay_of_a_missing_path_is_one_clear_error(tmp_path):
     )
     assert proc.returncode == 1
     assert proc.stderr.startswith("rangebearing: error:") and "Traceback" not in proc.stderr
+
+
+def test_run_check_resolves_destinations_and_names_the_file(tmp_path, capsys, monkeypatch):
+    import socket
+
+    real = socket.getaddrinfo
+
+    def no_dns(host, *args, **kw):  # never ask a real resolver from a test
+        if host == "no-such-robot.invalid":
+            raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
+        return real(host, *args, **kw)
+
+    monkeypatch.setattr(socket, "getaddrinfo", no_dns)
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text('publish: {unicast: ["no-such-robot.invalid:47800"]}\nsource: {kind: synthetic}\n')
+    assert main(["run", "--config", str(cfg), "--check"]) == 2
+    err = capsys.readouterr().err
+    assert f"{cfg}: 1 problem" in err and "no-such-robot.invalid" in err
+
+
+@pytest.mark.parametrize("spec, message", [("picamera2:abc", "must be an integer"), ("recorded:", "source.path")])
+def test_bad_command_line_sources_are_config_errors(spec, message, capsys):
+    assert main(["run", "--source", spec, "--check"]) == 2
+    assert message in capsys.readouterr().err

@@ -242,6 +242,19 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
     return cfg
 
 
+def check(cfg: Config) -> None:
+    """Re-run the cross-field checks on a config changed after loading (e.g. a command-line source).
+
+    Raises
+    ------
+    ConfigError
+        Naming every problem and the config's file.
+    """
+    problems = _cross_checks(cfg)
+    if problems:
+        raise ConfigError(problems, cfg.source_file)
+
+
 def _cross_checks(cfg: Config) -> list[str]:
     p = []
     cam, lm = cfg.camera, cfg.landmark

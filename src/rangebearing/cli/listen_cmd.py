@@ -56,20 +56,27 @@ def register(subparsers: Any) -> None:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--port", type=_port, default=DEFAULT_PORT,
-                   help=f"UDP port to listen on (default {DEFAULT_PORT})")
-    p.add_argument("--host", default="127.0.0.1",
-                   help="local address for unicast (default 127.0.0.1; "
-                        "0.0.0.0 hears robots on the network)")
-    p.add_argument("--group", default=None, metavar="G",
-                   help="join this IPv4 multicast group instead, e.g. 239.255.47.80")
-    p.add_argument("--interface", default=None, metavar="I",
-                   help="address of the interface to join --group on (default 127.0.0.1)")
+    p.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"UDP port to listen on (default {DEFAULT_PORT})")
+    p.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="local address for unicast (default 127.0.0.1; 0.0.0.0 hears robots on the network)",
+    )
+    p.add_argument(
+        "--group", default=None, metavar="G", help="join this IPv4 multicast group instead, e.g. 239.255.47.80"
+    )
+    p.add_argument(
+        "--interface", default=None, metavar="I", help="address of the interface to join --group on (default 127.0.0.1)"
+    )
     p.add_argument("--json", action="store_true", help="print each datagram's raw JSON instead")
-    p.add_argument("--count", type=_positive(int), default=None, metavar="N",
-                   help="exit 0 after N readings")
-    p.add_argument("--timeout", type=_positive(float), default=None, metavar="S",
-                   help="exit 1 if no reading arrives for S seconds (default: wait forever)")
+    p.add_argument("--count", type=_positive(int), default=None, metavar="N", help="exit 0 after N readings")
+    p.add_argument(
+        "--timeout",
+        type=_positive(float),
+        default=None,
+        metavar="S",
+        help="exit 1 if no reading arrives for S seconds (default: wait forever)",
+    )
     p.set_defaults(func=run)
 
 
@@ -112,8 +119,10 @@ def echo(
         got = sub.recv_datagram(timeout_s)
         if got is None:
             where = f"{sub.group or sub.address[0]}:{sub.port}"
-            return _error(f"no reading arrived on {where} within {timeout_s:g} s"
-                          + (f" ({sub.dropped} invalid datagrams dropped)" if sub.dropped else ""))
+            return _error(
+                f"no reading arrived on {where} within {timeout_s:g} s"
+                + (f" ({sub.dropped} invalid datagrams dropped)" if sub.dropped else "")
+            )
         reading, data = got
         line = _one_line_json(data) if as_json else format_reading(reading)
         print(line, file=out, flush=True)
@@ -127,8 +136,7 @@ def run(args: argparse.Namespace) -> int:
         return _error("--interface only applies with --group")
     where = f"{args.group or args.host}:{args.port}"
     try:
-        sub = Subscriber(port=args.port, host=args.host, group=args.group,
-                         interface=args.interface or "127.0.0.1")
+        sub = Subscriber(port=args.port, host=args.host, group=args.group, interface=args.interface or "127.0.0.1")
     except OSError as exc:
         return _error(f"cannot listen on {where}: {exc.strerror or exc}")
     try:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import signal
 import sys
 import threading
@@ -12,7 +13,7 @@ from typing import Any
 
 import cv2
 
-from ..config import Config, load_config
+from ..config import Config, check, load_config
 from ..errors import FrameError, SourceError
 from ..sources.base import open_source
 from .common import add_config_arg
@@ -39,6 +40,7 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     cfg = load_config(args.config) if args.config else Config()
     src_cfg = source_from_args(args, cfg.source) or cfg.source
+    check(dataclasses.replace(cfg, source=src_cfg))
     out = Path(args.out)
     try:
         out.mkdir(parents=True, exist_ok=True)

@@ -8,7 +8,7 @@ import logging
 import sys
 from typing import Any, Callable, Optional
 
-from ..config import Config, SourceConfig, load_config
+from ..config import Config, SourceConfig, check, load_config
 from ..daemon import Daemon
 from ..errors import ConfigError
 from ..net.protocol import decode_reading
@@ -57,7 +57,9 @@ def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[S
     if spec:
         kind, _, rest = spec.partition(":")
         if kind == "picamera2":
-            src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest.isdigit() else src.camera_num)
+            if rest and not rest.isdigit():
+                raise ConfigError([f"--source: {spec!r}: the camera number must be an integer"], "command line")
+            src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest else src.camera_num)
         elif kind == "opencv":
             src = dataclasses.replace(src, kind="opencv", device=rest or src.device)
         elif kind == "synthetic":
@@ -70,8 +72,6 @@ def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[S
         src = dataclasses.replace(src, fps=fps)
     if loop:
         src = dataclasses.replace(src, loop=True)
-    if src.kind == "recorded" and not src.path:
-        raise ConfigError(["--source: recorded frames need a path"], "command line")
     return src
 
 
@@ -80,7 +80,11 @@ def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
 
 
 def publisher_for(cfg: Config) -> UdpPublisher:
-    return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
+    """The UDP publisher; a destination that does not resolve is a problem of the config file."""
+    try:
+        return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
+    except ConfigError as exc:
+        raise ConfigError(exc.problems, cfg.source_file) from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -88,9 +92,9 @@ def run(args: argparse.Namespace) -> int:
     override = source_from_args(args, cfg.source)
     if override is not None:
         cfg = dataclasses.replace(cfg, source=override)
-    if cfg.source.kind == "recorded" and not cfg.source.path:
-        raise ConfigError(["source.path: required when source.kind is 'recorded'"], cfg.source_file)
+        check(cfg)
     if args.check:
+        publisher_for(cfg).close()  # destinations resolve, multicast interface exists
         print(f"{cfg.source_file}: OK")
         return 0
     echo = None

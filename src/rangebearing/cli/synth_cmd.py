@@ -58,21 +58,32 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
     p.add_argument("--frames", required=True, type=_count, metavar="N", help="number of frames")
-    p.add_argument("--seed", required=True, type=_count, metavar="S",
-                   help="random seed: the same seed gives the same frames")
-    p.add_argument("--preset", choices=PRESETS, default="paper",
-                   help="scene family (default: paper)")
-    p.add_argument("--format", dest="fmt", choices=FORMATS, default="png",
-                   help="image format (default: png)")
-    p.add_argument("--jpeg-quality", type=_quality, default=90, metavar="Q",
-                   help="JPEG quality 1-100 for --format jpg (default: 90)")
-    p.add_argument("--size", type=_size, metavar="WxH",
-                   help="image size; the default 640x480 camera scaled to the same field of view")
-    p.add_argument("--distortion", type=_distortion, metavar="k1,k2",
-                   help="radial distortion (OpenCV k1, k2), e.g. --distortion=-0.2,0.05 "
-                   "(with '=' when k1 is negative); default none")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace frames and truth.csv already in DIR")
+    p.add_argument(
+        "--seed", required=True, type=_count, metavar="S", help="random seed: the same seed gives the same frames"
+    )
+    p.add_argument("--preset", choices=PRESETS, default="paper", help="scene family (default: paper)")
+    p.add_argument("--format", dest="fmt", choices=FORMATS, default="png", help="image format (default: png)")
+    p.add_argument(
+        "--jpeg-quality",
+        type=_quality,
+        default=90,
+        metavar="Q",
+        help="JPEG quality 1-100 for --format jpg (default: 90)",
+    )
+    p.add_argument(
+        "--size",
+        type=_size,
+        metavar="WxH",
+        help="image size; the default 640x480 camera scaled to the same field of view",
+    )
+    p.add_argument(
+        "--distortion",
+        type=_distortion,
+        metavar="k1,k2",
+        help="radial distortion (OpenCV k1, k2), e.g. --distortion=-0.2,0.05 "
+        "(with '=' when k1 is negative); default none",
+    )
+    p.add_argument("--overwrite", action="store_true", help="replace frames and truth.csv already in DIR")
     p.set_defaults(func=run)
 
 
@@ -84,8 +95,9 @@ def run(args: argparse.Namespace) -> int:
         camera = dataclasses.replace(camera, distortion=(*args.distortion, 0.0, 0.0, 0.0))
     start = time.perf_counter()
     try:
-        truth = write_dataset(args.out, args.frames, args.seed, args.preset, args.fmt,
-                              args.jpeg_quality, camera, overwrite=args.overwrite)
+        truth = write_dataset(
+            args.out, args.frames, args.seed, args.preset, args.fmt, args.jpeg_quality, camera, overwrite=args.overwrite
+        )
     except FileExistsError as exc:
         print(f"rangebearing: error: {exc} (--overwrite replaces them)", file=sys.stderr)
         return 1
@@ -94,8 +106,10 @@ def run(args: argparse.Namespace) -> int:
         return 1
     seconds = time.perf_counter() - start
     with_landmark = len({row.frame for row in truth})
-    print(f"synth: {args.frames} {args.preset} frames ({camera.width_px}x{camera.height_px} "
-          f"{args.fmt}, seed {args.seed}) in {args.out}: {len(truth)} landmarks, "
-          f"{args.frames - with_landmark} frames without one; {TRUTH_FILE}, {CAMERA_FILE}; "
-          f"{seconds:.1f} s")
+    print(
+        f"synth: {args.frames} {args.preset} frames ({camera.width_px}x{camera.height_px} "
+        f"{args.fmt}, seed {args.seed}) in {args.out}: {len(truth)} landmarks, "
+        f"{args.frames - with_landmark} frames without one; {TRUTH_FILE}, {CAMERA_FILE}; "
+        f"{seconds:.1f} s"
+    )
     return 0
