@@ -24,12 +24,16 @@ class Match:
 
     @property
     def range_err_pct(self) -> float:
-        assert self.found is not None
+        """|error| / truth in percent; NaN for a missed landmark."""
+        if self.found is None:
+            return math.nan
         return 100.0 * abs(self.found.range_m - self.truth.range_m) / self.truth.range_m
 
     @property
     def bearing_err_deg(self) -> float:
-        assert self.found is not None
+        """|error| in degrees; NaN for a missed landmark."""
+        if self.found is None:
+            return math.nan
         return math.degrees(abs(self.found.bearing_rad - self.truth.bearing_rad))
 
 
