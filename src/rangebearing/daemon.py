@@ -15,7 +15,7 @@ import logging
 import signal
 import threading
 import time
-from typing import Callable, Optional, TextIO
+from typing import Callable, Optional
 
 from .config import Config, SourceConfig, load_config
 from .core.pipeline import Pipeline
@@ -234,11 +234,3 @@ class Daemon:
             log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
             self._source = self._open_source(self.cfg, self._stop.wait)
             return False
-
-
-def echo_to(stream: TextIO) -> Echo:
-    def echo(payload: bytes) -> None:
-        stream.write(payload.decode("utf-8") + "\n")
-        stream.flush()
-
-    return echo

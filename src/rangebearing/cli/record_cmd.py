@@ -13,10 +13,10 @@ from typing import Any
 
 import cv2
 
-from ..config import Config, check, load_config
+from ..config import check
 from ..errors import FrameError, SourceError
 from ..sources.base import open_source
-from .common import add_config_arg
+from .common import add_config_arg, config_from_args
 from .run_cmd import add_source_args, source_from_args
 
 
@@ -38,7 +38,7 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    cfg = load_config(args.config) if args.config else Config()
+    cfg = config_from_args(args)
     src_cfg = source_from_args(args, cfg.source) or cfg.source
     check(dataclasses.replace(cfg, source=src_cfg))
     out = Path(args.out)

@@ -8,14 +8,14 @@ import logging
 import sys
 from typing import Any, Callable, Optional
 
-from ..config import Config, SourceConfig, check, load_config
+from ..config import Config, SourceConfig, check
 from ..daemon import Daemon
 from ..errors import ConfigError
 from ..net.protocol import decode_reading
 from ..net.publisher import UdpPublisher
 from ..sdnotify import Notifier
 from ..sources.base import FrameSource, open_source
-from .common import add_config_arg
+from .common import add_config_arg, config_from_args
 from .listen_cmd import format_reading
 
 log = logging.getLogger("rangebearing.run")
@@ -88,7 +88,7 @@ def publisher_for(cfg: Config) -> UdpPublisher:
 
 
 def run(args: argparse.Namespace) -> int:
-    cfg = load_config(args.config) if args.config else Config()
+    cfg = config_from_args(args)
     override = source_from_args(args, cfg.source)
     if override is not None:
         cfg = dataclasses.replace(cfg, source=override)

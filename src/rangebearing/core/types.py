@@ -106,5 +106,4 @@ class FrameResult:
     """Everything the pipeline found in one frame. Nothing seen is an empty tuple."""
 
     landmarks: Tuple[Landmark, ...]
-    stage_s: Tuple[Tuple[str, float], ...] = ()
-    tracked: bool = False
+    tracked: bool = False  # measured in tracking windows rather than by a full-frame search

@@ -42,8 +42,9 @@ class RayGrid(NamedTuple):
 def _coefficients(camera: CameraIntrinsics) -> np.ndarray:
     d = tuple(camera.distortion)
     if len(d) not in (0, 4, 5, 8):
-        raise ConfigError([f"camera.distortion: {len(d)} coefficients; the renderer "
-                           "supports 4, 5 or 8"], "synthetic camera")
+        raise ConfigError(
+            [f"camera.distortion: {len(d)} coefficients; the renderer supports 4, 5 or 8"], "synthetic camera"
+        )
     return np.array(d + (0.0,) * (8 - len(d)), dtype=np.float64)
 
 
@@ -69,8 +70,9 @@ def _forward_jacobian(x: np.ndarray, y: np.ndarray, k: np.ndarray) -> Tuple[np.n
     return (xa - xb) / (2 * h), (xc - xe) / (2 * h), (ya - yb) / (2 * h), (yc - ye) / (2 * h)
 
 
-def _undistort(xd: np.ndarray, yd: np.ndarray, camera: CameraIntrinsics,
-               k: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+def _undistort(
+    xd: np.ndarray, yd: np.ndarray, camera: CameraIntrinsics, k: np.ndarray
+) -> Tuple[np.ndarray, np.ndarray]:
     """Exact inverse of :func:`distort`: OpenCV's estimate polished by Newton steps."""
     cam = np.array([[camera.fx_px, 0, camera.cx_px], [0, camera.fy_px, camera.cy_px], [0, 0, 1]])
     pix = np.stack([xd * camera.fx_px + camera.cx_px, yd * camera.fy_px + camera.cy_px], -1)
@@ -110,15 +112,17 @@ def ray_grid(camera: CameraIntrinsics) -> RayGrid:
         a, b, c, d = _forward_jacobian(x, y, k)
         det = a * d - b * c
         # d(undistorted)/d(pixel) = inverse forward Jacobian · diag(1/fx, 1/fy)
-        grid = RayGrid(x, y, d / det / camera.fx_px, -b / det / camera.fy_px,
-                       -c / det / camera.fx_px, a / det / camera.fy_px)
+        grid = RayGrid(
+            x, y, d / det / camera.fx_px, -b / det / camera.fy_px, -c / det / camera.fx_px, a / det / camera.fy_px
+        )
     for arr in grid:
         arr.setflags(write=False)
     return grid
 
 
-def project(camera: CameraIntrinsics, camera_height_m: float, x_m: np.ndarray,
-            y_m: np.ndarray, z_m: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+def project(
+    camera: CameraIntrinsics, camera_height_m: float, x_m: np.ndarray, y_m: np.ndarray, z_m: np.ndarray
+) -> Tuple[np.ndarray, np.ndarray]:
     """World points to pixel coordinates ``(u, v)``, with distortion; NaN behind the camera."""
     x_m, y_m, z_m = (np.asarray(a, dtype=np.float64) for a in (x_m, y_m, z_m))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -129,8 +133,9 @@ def project(camera: CameraIntrinsics, camera_height_m: float, x_m: np.ndarray,
     return camera.cx_px + camera.fx_px * xn, camera.cy_px + camera.fy_px * yn
 
 
-def pixel_rect(camera: CameraIntrinsics, xn: Sequence[float], yn: Sequence[float],
-               pad_px: float = 2.0) -> Optional[Rect]:
+def pixel_rect(
+    camera: CameraIntrinsics, xn: Sequence[float], yn: Sequence[float], pad_px: float = 2.0
+) -> Optional[Rect]:
     """Pixels whose ray falls inside the normalised box ``xn × yn`` (padded), or None."""
     h, w = camera.height_px, camera.width_px
     if not camera.has_distortion:
@@ -150,14 +155,20 @@ def pixel_rect(camera: CameraIntrinsics, xn: Sequence[float], yn: Sequence[float
     return (r0, r1, c0, c1) if r0 < r1 and c0 < c1 else None
 
 
-def cylinder_bbox_px(scene: Scene, x_m: float, z_m: float, radius_m: float, bottom_m: float,
-                     top_m: float) -> Optional[BoxPx]:
+def cylinder_bbox_px(
+    scene: Scene, x_m: float, z_m: float, radius_m: float, bottom_m: float, top_m: float
+) -> Optional[BoxPx]:
     """Image extent ``(u0, v0, u1, v1)`` of a vertical cylinder, unclipped; None if behind."""
     ang = np.linspace(0.0, 2.0 * np.pi, 360, endpoint=False)
     heights = np.linspace(bottom_m, top_m, 7)
     xs = (x_m + radius_m * np.cos(ang))[None, :] + 0.0 * heights[:, None]
     zs = (z_m + radius_m * np.sin(ang))[None, :] + 0.0 * heights[:, None]
     ys = heights[:, None] + 0.0 * ang[None, :]
+    return points_bbox(scene, xs, ys, zs)
+
+
+def points_bbox(scene: Scene, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray) -> Optional[BoxPx]:
+    """Image extent ``(u0, v0, u1, v1)`` of world points, unclipped; None if any is behind the camera."""
     if np.min(zs) <= 1e-3:
         return None
     u, v = project(scene.camera, scene.camera_height_m, xs, ys, zs)
@@ -169,8 +180,7 @@ def cylinder_bbox_px(scene: Scene, x_m: float, z_m: float, radius_m: float, bott
 def landmark_bbox_px(scene: Scene, lm: LandmarkPose, with_robot: bool = False) -> Optional[BoxPx]:
     """Image extent of a landmark's cylinder (and of its robot, if asked)."""
     g = scene.geometry
-    box = cylinder_bbox_px(scene, lm.x_m, lm.z_m, g.radius_m, lm.base_height_m,
-                           lm.base_height_m + g.height_m)
+    box = cylinder_bbox_px(scene, lm.x_m, lm.z_m, g.radius_m, lm.base_height_m, lm.base_height_m + g.height_m)
     if box is None or not with_robot:
         return box
     body = cylinder_bbox_px(scene, lm.x_m, lm.z_m, scene.robot_radius_m, 0.0, lm.base_height_m)
@@ -184,6 +194,9 @@ def inside_image(camera: CameraIntrinsics, box: Optional[BoxPx], margin_px: floa
     if box is None:
         return False
     u0, v0, u1, v1 = box
-    return (u0 >= margin_px - 0.5 and v0 >= margin_px - 0.5
-            and u1 <= camera.width_px - 0.5 - margin_px
-            and v1 <= camera.height_px - 0.5 - margin_px)
+    return (
+        u0 >= margin_px - 0.5
+        and v0 >= margin_px - 0.5
+        and u1 <= camera.width_px - 0.5 - margin_px
+        and v1 <= camera.height_px - 0.5 - margin_px
+    )

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..core.types import CameraIntrinsics
 from . import _draw as d
-from .camera import BoxPx, cylinder_bbox_px, landmark_bbox_px, project
+from .camera import BoxPx, cylinder_bbox_px, landmark_bbox_px, points_bbox
 from .scene import RGB, Box, Cylinder, FloorPatch, LandmarkPose, Poster, Scene
 
 RED_PAINTS = ((0.70, 0.07, 0.06), (0.78, 0.10, 0.08), (0.62, 0.05, 0.10), (0.75, 0.16, 0.05))
@@ -42,17 +42,7 @@ def colour_class(rgb: RGB) -> Optional[str]:
     return None
 
 
-def _points_bbox(scene: Scene, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray) -> Optional[BoxPx]:
-    if np.min(zs) <= 1e-3:
-        return None
-    u, v = project(scene.camera, scene.camera_height_m, xs, ys, zs)
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(v))):
-        return None
-    return float(u.min()), float(v.min()), float(u.max()), float(v.max())
-
-
-def _grid(a: Tuple[float, float], b: Tuple[float, float], c: Tuple[float, float]
-          ) -> Tuple[np.ndarray, ...]:
+def _grid(a: Tuple[float, float], b: Tuple[float, float], c: Tuple[float, float]) -> Tuple[np.ndarray, ...]:
     s = [np.linspace(lo, hi, 9) for lo, hi in (a, b, c)]
     return tuple(m.ravel() for m in np.meshgrid(*s))
 
@@ -69,19 +59,25 @@ def regions(scene: Scene) -> List[Tuple[str, BoxPx]]:
     for c in scene.cylinders:
         add(c.colour, cylinder_bbox_px(scene, c.x_m, c.z_m, c.radius_m, c.bottom_m, c.top_m))
     for b in scene.boxes:
-        add(b.colour, _points_bbox(scene, *_grid((b.x_m - b.width_m / 2, b.x_m + b.width_m / 2),
-                                                 (b.bottom_m, b.top_m),
-                                                 (b.z_m - b.depth_m / 2, b.z_m + b.depth_m / 2))))
+        add(
+            b.colour,
+            points_bbox(
+                scene,
+                *_grid(
+                    (b.x_m - b.width_m / 2, b.x_m + b.width_m / 2),
+                    (b.bottom_m, b.top_m),
+                    (b.z_m - b.depth_m / 2, b.z_m + b.depth_m / 2),
+                ),
+            ),
+        )
     if scene.wall_distance_m is not None:
         zw = scene.wall_distance_m
         for p in scene.posters:
-            add(p.colour, _points_bbox(scene, *_grid((p.x_min_m, p.x_max_m),
-                                                     (p.bottom_m, p.top_m), (zw, zw))))
+            add(p.colour, points_bbox(scene, *_grid((p.x_min_m, p.x_max_m), (p.bottom_m, p.top_m), (zw, zw))))
     for f in scene.floor_patches:
         z0 = max(f.z_min_m, 0.05)
         if f.z_max_m > z0:
-            add(f.colour, _points_bbox(scene, *_grid((f.x_min_m, f.x_max_m), (0.0, 0.0),
-                                                     (z0, f.z_max_m))))
+            add(f.colour, points_bbox(scene, *_grid((f.x_min_m, f.x_max_m), (0.0, 0.0), (z0, f.z_max_m))))
     return out
 
 
@@ -125,15 +121,12 @@ def layout_ok(scene: Scene) -> bool:
     objects: List[Solid] = [*scene.cylinders, *scene.boxes]
     feet = [_footprint(o) for o in objects]
     g = scene.geometry
-    feet += [(lm.x_m, lm.z_m, scene.robot_radius_m, 0.0, lm.base_height_m + g.height_m)
-             for lm in scene.landmarks]
+    feet += [(lm.x_m, lm.z_m, scene.robot_radius_m, 0.0, lm.base_height_m + g.height_m) for lm in scene.landmarks]
     if any(_collide(a, b) for i, a in enumerate(feet) for b in feet[:i]):
         return False
-    if scene.wall_distance_m is not None and any(f[1] + f[2] > scene.wall_distance_m
-                                                 for f in feet):
+    if scene.wall_distance_m is not None and any(f[1] + f[2] > scene.wall_distance_m for f in feet):
         return False
-    others = [b for _, b in found] + [cylinder_bbox_px(scene, *_footprint(o)[:3], 0.0, 1.0)
-                                      for o in objects]
+    others = [b for _, b in found] + [cylinder_bbox_px(scene, *_footprint(o)[:3], 0.0, 1.0) for o in objects]
     for lm in scene.landmarks:
         box = landmark_bbox_px(scene, lm, with_robot=True)
         if box is None:
@@ -162,22 +155,34 @@ def _distractors(rng: np.random.Generator, scene: Scene) -> Scene:
         return d.jitter(rng, table[int(rng.integers(len(table)))], 0.02)
 
     for _ in range(int(rng.integers(2, 6))):
-        kind = ("red cylinder", "blue cylinder", "red box", "blue box", "above", "beside",
-                "poster", "patch")[int(rng.integers(8))]
+        kind = ("red cylinder", "blue cylinder", "red box", "blue box", "above", "beside", "poster", "patch")[
+            int(rng.integers(8))
+        ]
         x, z = spot()
         if kind.endswith("cylinder"):
-            cyl.append(Cylinder(x, z, d.uniform(rng, 0.012, 0.05), 0.0, d.uniform(rng, 0.03, 0.16),
-                                paint(kind.split()[0])))
+            cyl.append(
+                Cylinder(x, z, d.uniform(rng, 0.012, 0.05), 0.0, d.uniform(rng, 0.03, 0.16), paint(kind.split()[0]))
+            )
         elif kind.endswith("box"):
-            box.append(Box(x, z, d.uniform(rng, 0.03, 0.12), d.uniform(rng, 0.03, 0.12), 0.0,
-                           d.uniform(rng, 0.03, 0.15), paint(kind.split()[0])))
+            box.append(
+                Box(
+                    x,
+                    z,
+                    d.uniform(rng, 0.03, 0.12),
+                    d.uniform(rng, 0.03, 0.12),
+                    0.0,
+                    d.uniform(rng, 0.03, 0.15),
+                    paint(kind.split()[0]),
+                )
+            )
         elif kind == "above":  # a red box high on a grey pedestal behind a blue cylinder
             top, w = d.uniform(rng, 0.30, 0.45), d.uniform(rng, 0.03, 0.05)
             box.append(Box(x, z, w * 0.6, w * 0.6, 0.0, top - 0.03, PEDESTAL))
             box.append(Box(x, z, w, w, top - 0.03, top, paint("red")))
             zb = z - d.uniform(rng, 0.1, 0.25)
-            cyl.append(Cylinder(x * zb / z, zb, d.uniform(rng, 0.012, 0.02), 0.0,
-                                d.uniform(rng, 0.03, 0.06), paint("blue")))
+            cyl.append(
+                Cylinder(x * zb / z, zb, d.uniform(rng, 0.012, 0.02), 0.0, d.uniform(rng, 0.03, 0.06), paint("blue"))
+            )
         elif kind == "beside":
             r = d.uniform(rng, 0.012, 0.025)
             gap = d.uniform(rng, 4.0, 8.0) * r * rng.choice([-1.0, 1.0])
@@ -191,10 +196,10 @@ def _distractors(rng: np.random.Generator, scene: Scene) -> Scene:
         elif kind == "patch":
             w, dz = d.uniform(rng, 0.3, 1.2), d.uniform(rng, 0.3, 1.0)
             tint = PATCH_TINTS[int(rng.integers(len(PATCH_TINTS)))]
-            patches.append(FloorPatch(x - w / 2, x + w / 2, z - dz / 2, z + dz / 2,
-                                      d.jitter(rng, tint)))
-    return dataclasses.replace(scene, cylinders=tuple(cyl), boxes=tuple(box),
-                               posters=tuple(posters), floor_patches=tuple(patches))
+            patches.append(FloorPatch(x - w / 2, x + w / 2, z - dz / 2, z + dz / 2, d.jitter(rng, tint)))
+    return dataclasses.replace(
+        scene, cylinders=tuple(cyl), boxes=tuple(box), posters=tuple(posters), floor_patches=tuple(patches)
+    )
 
 
 def clutter_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
@@ -202,8 +207,13 @@ def clutter_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
     with_landmark = rng.random() < 0.5
     for _ in range(200):
         room = d.tinted_room(rng) if rng.random() < 0.5 else d.neutral_room(rng)
-        base = Scene(camera=camera, lighting=d.lighting(rng, d.LIGHTS[int(rng.integers(5))]),
-                     imaging=d.imaging(rng), wall_distance_m=d.uniform(rng, 1.2, 2.5), **room)
+        base = Scene(
+            camera=camera,
+            lighting=d.lighting(rng, d.LIGHTS[int(rng.integers(5))]),
+            imaging=d.imaging(rng),
+            wall_distance_m=d.uniform(rng, 1.2, 2.5),
+            **room,
+        )
         lms: Tuple[LandmarkPose, ...] = ()
         if with_landmark:
             lm = d.draw_landmark(rng, base, lambda: d.log_uniform(rng, 0.25, 1.2))
