@@ -8,7 +8,7 @@ centre. Bearings are positive to the *left* of the optical axis (REP 103).
 from __future__ import annotations
 
 import math
-from typing import Tuple
+from typing import Optional, Tuple
 
 from .._compat import frozen
 
@@ -99,6 +99,13 @@ class Landmark:
     width_px: float
     bbox_px: BBox
     in_envelope: bool
+    # one-standard-deviation uncertainty of this measurement (pixel noise and band size through the model)
+    range_sigma_m: float = 0.0
+    bearing_sigma_rad: float = 0.0
+    visible: float = 1.0  # fraction of the landmark seen (0-1); below 1 it is partly hidden or merged
+    track_id: int = -1  # stable per neighbour while in view; -1 before tracking assigns one
+    range_rate_mps: Optional[float] = None  # from the per-track constant-velocity filter, once it has history
+    bearing_rate_radps: Optional[float] = None
 
 
 @frozen
