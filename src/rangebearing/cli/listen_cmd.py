@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import os
@@ -80,10 +81,35 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
+def printable(text: str) -> str:
+    """``text`` safe for a terminal: control characters, lone surrogates and other
+    non-printables (and the backslash itself) written as ``\\x1b``, ``\\u202e``, ``\\\\``.
+
+    Robot ids come from the network: raw, a newline would fake a reading line and an
+    ANSI escape would drive the terminal.
+    """
+    if text.isprintable() and "\\" not in text:
+        return text
+    out = []
+    for ch in text:
+        code = ord(ch)
+        if ch == "\\":
+            out.append("\\\\")
+        elif ch.isprintable():
+            out.append(ch)
+        elif code < 0x100:
+            out.append(f"\\x{code:02x}")
+        elif code < 0x10000:
+            out.append(f"\\u{code:04x}")
+        else:
+            out.append(f"\\U{code:08x}")
+    return "".join(out)
+
+
 def format_reading(reading: Reading) -> str:
-    """One human-readable line for one reading."""
+    """One human-readable line for one reading (the robot id escaped by :func:`printable`)."""
     n = len(reading.landmarks)
-    head = f"{reading.robot} #{reading.seq} t={reading.t:.3f}  {n} landmark{'' if n == 1 else 's'}"
+    head = f"{printable(reading.robot)} #{reading.seq} t={reading.t:.3f}  {n} landmark{'' if n == 1 else 's'}"
     parts = [describe(lm) for lm in reading.landmarks]
     line = f"{head}: {' | '.join(parts)}" if parts else head
     extras = []
@@ -101,8 +127,10 @@ def _error(message: str) -> int:
 
 def _one_line_json(data: bytes) -> str:
     text = data.decode("utf-8").strip()
-    if "\n" in text or "\r" in text:  # another writer pretty-printed it
-        text = json.dumps(json.loads(text), separators=(",", ":"), ensure_ascii=False)
+    if not (text.isascii() and text.isprintable()):
+        # Pretty-printed by another writer, or raw non-ASCII (C1 controls, bidi overrides):
+        # one line of ASCII, every other character as a JSON \u escape.
+        text = json.dumps(json.loads(text), separators=(",", ":"), ensure_ascii=True)
     return text
 
 
@@ -139,6 +167,8 @@ def run(args: argparse.Namespace) -> int:
         sub = Subscriber(port=args.port, host=args.host, group=args.group, interface=args.interface or "127.0.0.1")
     except OSError as exc:
         return _error(f"cannot listen on {where}: {exc.strerror or exc}")
+    if isinstance(sys.stdout, io.TextIOWrapper):  # a terminal that cannot show a character gets an escape
+        sys.stdout.reconfigure(errors="backslashreplace")
     try:
         with sub:
             return echo(sub, sys.stdout, args.json, args.count, args.timeout)

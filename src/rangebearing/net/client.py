@@ -115,7 +115,7 @@ class Subscriber:
                 return None
             except BlockingIOError:  # a zero timeout with nothing queued
                 return None
-            except ConnectionResetError:  # Windows reports ICMP errors on recv
+            except ConnectionError:  # ICMP errors reported on recv (Windows; Linux with IP_RECVERR)
                 continue
             try:
                 reading = decode_reading(data, sender=(str(addr[0]), int(addr[1])))

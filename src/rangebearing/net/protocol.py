@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import math
 import operator
+import sys
 from typing import Any, Callable, Dict, Iterable, List, Optional, Protocol, Tuple
 
 from .._compat import frozen
@@ -23,6 +24,9 @@ from ..errors import ProtocolError
 
 PROTOCOL_VERSION = 1
 MAX_DATAGRAM_BYTES = 65507  # the largest UDP payload over IPv4
+# The decoder's limits are the schema's: a finite IEEE double, and integers a double holds exactly.
+MAX_FINITE = sys.float_info.max
+MAX_INTEGER = 2**53 - 1
 
 # Rounding on the wire: 0.1 mm, 1e-5 rad (0.0006 degrees), 0.01 px, 1 µs.
 M_DIGITS = 4
@@ -107,7 +111,10 @@ class Reading:
 
 
 def _num(x: Any, digits: int, what: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-    v = float(x)
+    try:
+        v = float(x)
+    except (TypeError, ValueError, OverflowError):
+        raise ProtocolError(f"cannot encode {what}={_show(x)}: not a number") from None
     if not math.isfinite(v):
         raise ProtocolError(f"cannot encode {what}={v!r}: not a finite number")
     if not lo <= v <= hi:  # the limits decode_reading enforces: never send what a consumer must drop
@@ -120,8 +127,8 @@ def _count(n: Any, what: str) -> int:
         i = operator.index(n)
     except TypeError:
         raise ProtocolError(f"{what} must be an integer >= 0, got {n!r}") from None
-    if isinstance(n, bool) or i < 0:
-        raise ProtocolError(f"{what} must be an integer >= 0, got {n!r}")
+    if isinstance(n, bool) or not 0 <= i <= MAX_INTEGER:
+        raise ProtocolError(f"{what} must be an integer in [0, 2**53 - 1], got {n!r}")
     return i
 
 
@@ -187,8 +194,7 @@ def encode_reading(
         An argument cannot be represented (empty robot id, negative seq,
         a NaN or infinite number).
     """
-    if not isinstance(robot, str) or not robot:
-        raise ProtocolError(f"robot id must be a non-empty string, got {robot!r}")
+    _text(robot, "robot id")
     cols: Dict[str, List[Any]] = {name: [] for name in LANDMARK_FIELDS}
     for lm in landmarks:
         for name, value in landmark_fields(lm).items():
@@ -214,40 +220,60 @@ def _reject_constant(name: str) -> Any:
     raise ProtocolError(f"{name} is not allowed in a reading")
 
 
+def _show(v: Any, limit: int = 40) -> str:
+    """``repr(v)`` cut to ``limit`` characters: a hostile value never floods a message."""
+    if isinstance(v, (dict, list)):
+        return f"{type(v).__name__} of {len(v)}"
+    text = repr(v) if not isinstance(v, int) or abs(v) < 10**limit else f"an integer of {len(str(abs(v)))} digits"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    """A JSON number that fits a finite double (ints compared exactly: 10**309 is not)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    return -MAX_FINITE <= v <= MAX_FINITE  # False for NaN, inf and out-of-range ints
 
 
-def _number(v: Any, where: str, lo: float = -math.inf) -> float:
-    if not _is_number(v) or v < lo:
+def _number(v: Any, where: str, lo: float = -math.inf, hi: float = math.inf) -> float:
+    if not _is_number(v) or not lo <= v <= hi:
         bound = "" if lo == -math.inf else f" >= {lo:g}"
-        raise ProtocolError(f"{where}: expected a finite number{bound}, got {v!r}")
+        bound += "" if hi == math.inf else f" <= {hi:g}"
+        raise ProtocolError(f"{where}: expected a finite number{bound}, got {_show(v)}")
     return float(v)
 
 
 def _integer(v: Any, where: str) -> int:
-    if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-        raise ProtocolError(f"{where}: expected an integer >= 0, got {v!r}")
-    return v
+    # JSON does not tell 5 from 5.0 (nor does the JSON Schema): both are the integer 5.
+    if _is_number(v) and float(v).is_integer() and 0 <= v <= MAX_INTEGER:
+        return int(v)
+    raise ProtocolError(f"{where}: expected an integer in [0, 2**53 - 1], got {_show(v)}")
 
 
 def _boolean(v: Any, where: str) -> bool:
     if not isinstance(v, bool):
-        raise ProtocolError(f"{where}: expected true or false, got {v!r}")
+        raise ProtocolError(f"{where}: expected true or false, got {_show(v)}")
+    return v
+
+
+def _text(v: Any, where: str) -> str:
+    if not isinstance(v, str) or not v:
+        raise ProtocolError(f"{where}: expected a non-empty string, got {_show(v)}")
+    try:
+        v.encode("utf-8")
+    except UnicodeEncodeError:  # a lone surrogate ("\\ud800"): no consumer could print or store it
+        raise ProtocolError(f"{where}: not valid Unicode text (lone surrogate)") from None
     return v
 
 
 def _point(v: Any, where: str) -> XY:
     if not isinstance(v, list) or len(v) != 2:
-        raise ProtocolError(f"{where}: expected [x, y], got {v!r}")
+        raise ProtocolError(f"{where}: expected [x, y], got {_show(v)}")
     return (_number(v[0], where), _number(v[1], where))
 
 
 def _bearing(v: Any, where: str) -> float:
-    b = _number(v, where)
-    if not -math.pi <= b <= math.pi:
-        raise ProtocolError(f"{where}: {b!r} is outside [-pi, pi]")
-    return b
+    return _number(v, where, -math.pi, math.pi)
 
 
 def _size(v: Any, where: str) -> float:
@@ -321,23 +347,29 @@ def decode_reading(data: bytes, sender: Optional[Tuple[str, int]] = None) -> Rea
         msg = json.loads(bytes(data).decode("utf-8"), parse_constant=_reject_constant)
     except UnicodeDecodeError:
         raise ProtocolError("datagram is not UTF-8 text") from None
-    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError
-        if isinstance(exc, ProtocolError):
-            raise
-        raise ProtocolError(f"datagram is not JSON: {exc}") from None
+    except ProtocolError:
+        raise
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError is a ValueError; so is a 5,000-digit integer
+        raise ProtocolError(f"datagram is not JSON: {str(exc)[:80]}") from None
+    try:
+        return _reading(msg, sender)
+    except ProtocolError:
+        raise
+    except (TypeError, ValueError, OverflowError, RecursionError) as exc:  # a check above missed a case
+        raise ProtocolError(f"malformed reading: {type(exc).__name__}: {str(exc)[:80]}") from None
+
+
+def _reading(msg: Any, sender: Optional[Tuple[str, int]]) -> Reading:
     if not isinstance(msg, dict) or "v" not in msg:
         raise ProtocolError("not a rangebearing reading (no \"v\" field)")
     v = msg["v"]
-    if v != PROTOCOL_VERSION or isinstance(v, bool) or not isinstance(v, int):
-        raise ProtocolError(f"unsupported protocol version {v!r} (this reader speaks v1)")
+    if not _is_number(v) or v != PROTOCOL_VERSION:
+        raise ProtocolError(f"unsupported protocol version {_show(v)} (this reader speaks v1)")
     missing = [name for name in READING_FIELDS if name not in msg]
     if missing:
         raise ProtocolError(f"missing field(s) {', '.join(missing)}")
-    robot = msg["robot"]
-    if not isinstance(robot, str) or not robot:
-        raise ProtocolError(f"robot: expected a non-empty string, got {robot!r}")
     return Reading(
-        robot=robot,
+        robot=_text(msg["robot"], "robot"),
         seq=_integer(msg["seq"], "seq"),
         t=_number(msg["t"], "t"),
         landmarks=_landmarks(msg["landmarks"]),
