@@ -16,10 +16,11 @@ import numpy as np
 from rangebearing import Config
 from rangebearing._compat import frozen
 from rangebearing.config import PublishConfig, SourceConfig
-from rangebearing.daemon import Daemon
+from rangebearing.daemon.loop import Daemon
+from rangebearing.daemon.sdnotify import Notifier
 from rangebearing.net.publisher import UdpPublisher
-from rangebearing.sdnotify import Notifier
-from rangebearing.sources.base import Frame, FrameSource, open_source
+from rangebearing.sources.base import Frame, FrameSource
+from rangebearing.sources.factory import open_source
 
 END = b"END"  # not JSON, so never a reading
 

@@ -53,7 +53,7 @@ def stage_breakdown(cfg: Config, frames: Sequence[np.ndarray], repeats: int) -> 
     band_px = cam.fy_px * geom.band_height_m / cfg.model.envelope_range_m[1] / s
     ksize = band_preserving_ksize(det.median_ksize, band_px)
     limits, min_area = PairingLimits(), det.min_band_px * det.min_band_px
-    pipe = Pipeline(cfg, track=False)
+    pipe = Pipeline(cfg.pipeline, track=False)
     laps = Laps()
     found = 0
     for rep in range(repeats + 1):  # the first pass warms up

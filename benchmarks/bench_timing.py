@@ -59,9 +59,9 @@ def rangebearing_contenders(sc: ScenarioFrames, aruco: Optional[Process]) -> Lis
     cfg: Config = sc.cfg
     paper = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, method="paper"))
     out = [
-        Contender("paper", Pipeline(paper, track=False).process, sc.n_landmarks),
-        Contender("full", Pipeline(cfg, track=False).process, sc.n_landmarks),
-        Contender("track", Pipeline(cfg, track=True).process, sc.n_landmarks),
+        Contender("paper", Pipeline(paper.pipeline, track=False).process, sc.n_landmarks),
+        Contender("full", Pipeline(cfg.pipeline, track=False).process, sc.n_landmarks),
+        Contender("track", Pipeline(cfg.pipeline, track=True).process, sc.n_landmarks),
     ]
     if aruco is not None:
         out.append(Contender("aruco", aruco, len(sc.markers)))

@@ -12,8 +12,8 @@ import cv2
 import numpy as np
 import pytest
 
+from rangebearing.evaluation.truth import TruthRow
 from rangebearing.synth import Imaging, LandmarkPose, Scene, render
-from rangebearing.truth import TruthRow
 
 FAKES = Path(__file__).resolve().parent / "fakes"
 

@@ -11,7 +11,7 @@ import pytest
 
 from rangebearing import Pipeline, load_config
 from rangebearing.cli.main import main
-from rangebearing.evaluate import accuracy
+from rangebearing.evaluation.match import accuracy
 from rangebearing.synth import generate, write_dataset
 
 # preset, frames, seed, image format, min detection rate, max mean range error %, max mean bearing error °
@@ -46,7 +46,7 @@ def test_calibrate_writes_a_config_that_loads(calibrated, capsys):
 
 @pytest.mark.parametrize("preset, n, seed, fmt, min_rate, max_range_pct, max_bearing_deg", SETS)
 def test_accuracy_bounds(calibrated, preset, n, seed, fmt, min_rate, max_range_pct, max_bearing_deg):
-    pipe = Pipeline(load_config(calibrated), track=False)
+    pipe = Pipeline(load_config(calibrated).pipeline, track=False)
     report, _ = accuracy(
         (name, pipe.process(img).landmarks, rows) for name, img, rows in generate(n, seed, preset, fmt=fmt)
     )
@@ -60,7 +60,7 @@ def test_accuracy_bounds(calibrated, preset, n, seed, fmt, min_rate, max_range_p
 
 
 def test_clutter_without_landmarks_gives_nothing(calibrated):
-    pipe = Pipeline(load_config(calibrated), track=False)
+    pipe = Pipeline(load_config(calibrated).pipeline, track=False)
     empty = [(name, pipe.process(img).landmarks) for name, img, rows in generate(120, 7005, "clutter") if not rows]
     assert len(empty) >= 20
     assert [name for name, found in empty if found] == []

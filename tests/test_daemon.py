@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from rangebearing.config import Config, PublishConfig, SourceConfig
-from rangebearing.daemon import Daemon
+from rangebearing.daemon.loop import Daemon
 from rangebearing.net.protocol import decode_reading
 from rangebearing.net.publisher import MemoryPublisher, UdpPublisher
-from rangebearing.sources.base import open_source
+from rangebearing.sources.factory import open_source
 from rangebearing.synth import render
 from tests.conftest import STATIC_SCENE
 

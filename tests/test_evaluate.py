@@ -3,8 +3,8 @@ import math
 import pytest
 
 from rangebearing.core.types import Landmark
-from rangebearing.evaluate import accuracy, format_report, match_frame
-from rangebearing.truth import TruthRow
+from rangebearing.evaluation.match import accuracy, format_report, match_frame
+from rangebearing.evaluation.truth import TruthRow
 
 
 def lm(range_m, bearing_deg):

@@ -10,9 +10,9 @@ import pytest
 from rangebearing import Pipeline, load_config
 from rangebearing.cli.main import main
 from rangebearing.core.types import CameraIntrinsics
-from rangebearing.evaluate import accuracy
+from rangebearing.evaluation.match import accuracy
+from rangebearing.evaluation.truth import TruthRow, write_truth
 from rangebearing.synth import generate, write_dataset
-from rangebearing.truth import TruthRow, write_truth
 
 
 def test_replay_reads_a_video_and_matches_truth_by_frame_index(tmp_path, capsys):
@@ -40,7 +40,7 @@ def test_lens_distortion_is_undone_before_the_model():
     without = load_config(None)
     errors = {}
     for name, cfg in (("with", with_coeffs), ("without", without)):
-        pipe = Pipeline(cfg, track=False)
+        pipe = Pipeline(cfg.pipeline, track=False)
         report, _ = accuracy((n, pipe.process(img).landmarks, rows) for n, img, rows in frames)
         assert report.detection_rate == 1.0
         errors[name] = (report.range_err_pct_mean, report.bearing_err_deg_mean)

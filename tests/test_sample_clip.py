@@ -6,9 +6,9 @@ from pathlib import Path
 
 from rangebearing import Pipeline, load_config
 from rangebearing.cli.main import main
-from rangebearing.evaluate import accuracy
+from rangebearing.evaluation.match import accuracy
+from rangebearing.evaluation.truth import read_truth
 from rangebearing.sources.recorded import iter_recorded
-from rangebearing.truth import read_truth
 
 ROOT = Path(__file__).resolve().parents[1]
 CLIP = ROOT / "samples" / "clip"
@@ -16,7 +16,7 @@ CLIP = ROOT / "samples" / "clip"
 
 def test_sample_clip_with_default_config():
     truth = read_truth(CLIP / "truth.csv")
-    pipe = Pipeline(load_config(None), track=True)  # a real sequence: tracking on, as in the daemon
+    pipe = Pipeline(load_config(None).pipeline, track=True)  # a real sequence: tracking on, as in the daemon
     report, _ = accuracy((name, pipe.process(img).landmarks, truth.get(name, [])) for name, img in iter_recorded(CLIP))
     assert report.frames == 24 and report.truths == 48
     assert report.detection_rate == 1.0 and report.false_landmarks == 0

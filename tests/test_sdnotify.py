@@ -13,7 +13,7 @@ from typing import Iterator, List, Tuple
 
 import pytest
 
-from rangebearing.sdnotify import Notifier, notify_address, watchdog_interval_s
+from rangebearing.daemon.sdnotify import Notifier, notify_address, watchdog_interval_s
 
 pytestmark = pytest.mark.skipif(not hasattr(socket, "AF_UNIX"), reason="needs AF_UNIX")
 
@@ -141,7 +141,7 @@ def test_send_failure_is_counted_not_raised(
 ) -> None:
     n = Notifier({"NOTIFY_SOCKET": str(tmp_path / "nobody-listens")})
     assert n.enabled
-    with caplog.at_level(logging.DEBUG, logger="rangebearing.sdnotify"):
+    with caplog.at_level(logging.DEBUG, logger="rangebearing.daemon.sdnotify"):
         assert n.ready() is False
         assert n.watchdog() is False
     assert (n.sent, n.failures) == (0, 2)
@@ -180,7 +180,7 @@ def test_recovers_when_the_socket_appears_later(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("value", ["relative/path", "@", "vsock:2:1234", "x"])
 def test_unusable_notify_socket_disables(value: str, caplog: pytest.LogCaptureFixture) -> None:
-    with caplog.at_level(logging.WARNING, logger="rangebearing.sdnotify"):
+    with caplog.at_level(logging.WARNING, logger="rangebearing.daemon.sdnotify"):
         n = Notifier({"NOTIFY_SOCKET": value})
     assert not n.enabled
     assert n.ready() is False

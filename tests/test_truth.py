@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rangebearing.errors import RangeBearingError, TruthError
-from rangebearing.truth import TruthRow, read_truth, write_truth
+from rangebearing.evaluation.truth import TruthRow, read_truth, write_truth
 
 
 def test_round_trip_groups_rows_by_frame_in_order(tmp_path):

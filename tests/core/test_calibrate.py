@@ -3,8 +3,8 @@ import math
 
 import pytest
 
-from rangebearing.config import ModelConfig
-from rangebearing.core.calibrate import Sample, fit_model
+from rangebearing.core.fit import Sample, fit_model
+from rangebearing.core.params import ModelParams
 from rangebearing.errors import CalibrationError
 
 S, C, F = 0.0552, 0.0125, 634.0
@@ -21,7 +21,7 @@ def pinhole_samples(ranges, bearings):
 
 def test_pinhole_fit_recovers_spacing_and_c_and_the_envelope():
     s = pinhole_samples([0.2, 0.4, 0.7, 1.1, 1.6], [0.1, -0.3, 0.0, 0.35, -0.2])
-    fit = fit_model(s, ModelConfig())
+    fit = fit_model(s, ModelParams())
     assert fit.model.spacing_m == pytest.approx(S, rel=1e-9)
     assert fit.model.c_m == pytest.approx(C, abs=1e-9)
     assert fit.range_err_pct_max < 1e-6
@@ -36,7 +36,7 @@ def test_paper_fit_recovers_k_and_kh():
         d_v, d_h = k / L, kh * px
         r, b = math.hypot(d_v, d_h), math.atan2(d_h, d_v)
         samples.append(Sample(str(i), L, L / F, b, px, r, b))
-    fit = fit_model(samples, dataclasses.replace(ModelConfig(), kind="paper"))
+    fit = fit_model(samples, dataclasses.replace(ModelParams(), kind="paper"))
     assert fit.model.k_px_m == pytest.approx(k)
     assert fit.model.kh_m_per_px == pytest.approx(kh)
 
@@ -51,4 +51,4 @@ def test_paper_fit_recovers_k_and_kh():
 )
 def test_fit_refuses_data_that_cannot_support_it(samples, message):
     with pytest.raises(CalibrationError, match=message):
-        fit_model(samples, ModelConfig())
+        fit_model(samples, ModelParams())

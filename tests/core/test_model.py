@@ -6,14 +6,14 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rangebearing.config import ModelConfig
 from rangebearing.core.model import axis_bearing, in_envelope, normalised, paper_reading, pinhole_reading
+from rangebearing.core.params import ModelParams
 from rangebearing.core.types import CameraIntrinsics, LandmarkGeometry
 
 CAM = CameraIntrinsics()
 GEO = LandmarkGeometry()
-PIN = ModelConfig()
-PAPER = dataclasses.replace(ModelConfig(), kind="paper", k_px_m=35.0, kh_m_per_px=0.00079)
+PIN = ModelParams()
+PAPER = dataclasses.replace(ModelParams(), kind="paper", k_px_m=35.0, kh_m_per_px=0.00079)
 
 offsets = st.floats(min_value=-300, max_value=300, allow_nan=False).filter(lambda v: abs(v) > 1e-6)
 lengths = st.floats(min_value=15, max_value=250, allow_nan=False)

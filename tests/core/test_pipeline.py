@@ -22,18 +22,18 @@ SCENE = Scene(landmarks=(LandmarkPose(0.4, 0.1),), wall_distance_m=2.0)
 )
 def test_unusable_frames_raise_frame_error(frame, message):
     with pytest.raises(FrameError, match=re.escape(message)):
-        Pipeline(load_config(None)).process(frame)
+        Pipeline(load_config(None).pipeline).process(frame)
 
 
 def test_an_empty_scene_gives_no_landmarks():
-    assert Pipeline(load_config(None)).process(render(Scene(wall_distance_m=2.0))).landmarks == ()
+    assert Pipeline(load_config(None).pipeline).process(render(Scene(wall_distance_m=2.0))).landmarks == ()
 
 
 def test_a_smaller_frame_of_the_same_camera_reads_the_same():
     img = render(SCENE)
     small = img.reshape(240, 2, 320, 2, 3).mean(axis=(1, 3)).round().astype(np.uint8)
-    a = Pipeline(load_config(None)).process(img).landmarks[0]
-    b = Pipeline(load_config(None)).process(small).landmarks[0]
+    a = Pipeline(load_config(None).pipeline).process(img).landmarks[0]
+    b = Pipeline(load_config(None).pipeline).process(small).landmarks[0]
     assert b.range_m == pytest.approx(a.range_m, rel=0.01)
     assert b.bearing_rad == pytest.approx(a.bearing_rad, abs=0.002)
 
@@ -41,8 +41,8 @@ def test_a_smaller_frame_of_the_same_camera_reads_the_same():
 def test_readings_with_no_positive_range_are_dropped():
     cfg = load_config(None)
     broken = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, c_m=-0.5))
-    assert Pipeline(cfg).process(render(SCENE)).landmarks[0].range_m == pytest.approx(0.4, rel=0.01)
-    assert Pipeline(broken).process(render(SCENE)).landmarks == ()
+    assert Pipeline(cfg.pipeline).process(render(SCENE)).landmarks[0].range_m == pytest.approx(0.4, rel=0.01)
+    assert Pipeline(broken.pipeline).process(render(SCENE)).landmarks == ()
 
 
 def test_the_paper_method_finds_one_landmark_with_its_own_model():
@@ -52,6 +52,6 @@ def test_the_paper_method_finds_one_landmark_with_its_own_model():
         detection=dataclasses.replace(cfg.detection, method="paper"),
         model=dataclasses.replace(cfg.model, kind="paper"),
     )
-    (lm,) = Pipeline(paper).process(render(SCENE)).landmarks
+    (lm,) = Pipeline(paper.pipeline).process(render(SCENE)).landmarks
     assert lm.range_m == pytest.approx(0.4, rel=0.1)  # the paper's k = 35 px·m, uncalibrated
     assert lm.bearing_rad > 0

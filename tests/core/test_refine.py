@@ -1,12 +1,12 @@
 import numpy as np
 import pytest
 
-from rangebearing.config import DetectionConfig
 from rangebearing.core.color import to_hsv
 from rangebearing.core.detect import refine
+from rangebearing.core.params import DetectionParams
 from rangebearing.core.refine import band_weights, measure_bands, tile_centroids
 
-CFG = DetectionConfig()
+CFG = DetectionParams()
 RED, BLUE = np.array([40, 40, 200.0]), np.array([200, 60, 30.0])
 WHITE, BLACK = np.array([220, 220, 220.0]), np.array([15, 15, 15.0])
 

@@ -31,7 +31,7 @@ def moving_sequence(frames: int, newcomer_at: int = -1, seed: int = 0):
 
 def assert_same_readings(frames):
     cfg = load_config(None)
-    full, tracker = Pipeline(cfg, track=False), Pipeline(cfg, track=True)
+    full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
     tracked = 0
     for img in frames:
         a, b = full.process(img), tracker.process(img)
@@ -72,7 +72,7 @@ def test_tracking_matches_full_search_with_ten_landmarks_side_by_side():
 def test_a_newcomer_is_found_within_full_scan_every_frames(appears):
     cfg = load_config(None)
     bound = cfg.detection.full_scan_every
-    pipe = Pipeline(cfg, track=True)
+    pipe = Pipeline(cfg.pipeline, track=True)
     found_at = None
     for i, img in enumerate(moving_sequence(appears + bound + 1, newcomer_at=appears)):
         n = len(pipe.process(img).landmarks)
@@ -85,7 +85,7 @@ def test_a_newcomer_is_found_within_full_scan_every_frames(appears):
 
 def test_a_lost_landmark_triggers_a_full_scan_on_the_next_frame():
     cfg = dataclasses.replace(load_config(None))
-    pipe = Pipeline(cfg, track=True)
+    pipe = Pipeline(cfg.pipeline, track=True)
     still = Scene(landmarks=(LandmarkPose(0.6, 0.25),), wall_distance_m=2.5)
     jumped = Scene(landmarks=(LandmarkPose(0.6, -0.25),), wall_distance_m=2.5)
     pipe.process(render(still))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import sys
 from pathlib import Path
 from types import ModuleType
 from typing import List
@@ -151,12 +150,6 @@ class TestOpenSource:
     def test_unknown_kind(self) -> None:
         with pytest.raises(SourceError, match="unknown source kind"):
             open_source(SourceConfig(kind="tape"), CameraIntrinsics())
-
-
-def test_synthetic_without_the_renderer_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setitem(sys.modules, "rangebearing.sources.synthetic", None)
-    with pytest.raises(SourceError, match="not available"):
-        open_source(SourceConfig(kind="synthetic"), CameraIntrinsics())
 
 
 def test_open_source_paces_with_the_given_sleep(tmp_path: Path) -> None:

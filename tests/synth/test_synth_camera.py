@@ -12,8 +12,8 @@ import pytest
 from rangebearing.core.types import CameraIntrinsics
 from rangebearing.errors import ConfigError
 from rangebearing.synth import LandmarkPose, Lighting, Scene, landmark_bbox_px, project, ray_grid, render_linear
-from rangebearing.synth._draw import bearing_limits
 from rangebearing.synth.camera import inside_image
+from rangebearing.synth.sampling import bearing_limits
 
 from .reference import band_weights, centroid
 

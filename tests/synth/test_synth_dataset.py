@@ -12,8 +12,8 @@ from rangebearing.cli import synth_cmd
 from rangebearing.config import load_config
 from rangebearing.core.types import CameraIntrinsics
 from rangebearing.errors import ConfigError
+from rangebearing.evaluation.truth import read_truth
 from rangebearing.synth import LandmarkPose, Scene, generate, scene_truth, write_dataset
-from rangebearing.truth import read_truth
 
 
 def test_write_dataset_matches_generate(tmp_path):

@@ -8,12 +8,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..calibration import calibrate
 from ..config import dump_config
-from ..core.calibrate import Fit
+from ..core.fit import Fit
 from ..errors import CalibrationError, RangeBearingError
+from ..evaluation.calibrate import calibrate
+from ..evaluation.truth import read_truth
 from ..sources.recorded import count_recorded, iter_recorded
-from ..truth import read_truth
 from .common import add_config_arg, config_from_args, progress
 
 

@@ -15,7 +15,7 @@ import cv2
 
 from ..config import check
 from ..errors import FrameError, SourceError
-from ..sources.base import open_source
+from ..sources.factory import open_source
 from .common import add_config_arg, config_from_args
 from .run_cmd import add_source_args, source_from_args
 

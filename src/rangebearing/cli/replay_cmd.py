@@ -10,14 +10,14 @@ from typing import Any, List, Tuple, Union
 
 import cv2
 
-from ..annotate import annotate
 from ..core.pipeline import Pipeline
 from ..core.types import Landmark
 from ..errors import FrameError, SourceError
-from ..evaluate import accuracy, format_report
+from ..evaluation.annotate import annotate
+from ..evaluation.match import accuracy, format_report
+from ..evaluation.truth import read_truth
 from ..net.protocol import landmark_fields
 from ..sources.recorded import count_recorded, iter_recorded
-from ..truth import read_truth
 from .common import add_config_arg, config_from_args, describe, progress
 
 
@@ -41,7 +41,7 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     truth = read_truth(args.truth) if args.truth else None
-    pipe = Pipeline(cfg, track=args.track)
+    pipe = Pipeline(cfg.pipeline, track=args.track)
     path = Path(args.path)
     is_video = path.is_file()
     out = open(args.out, "w", encoding="utf-8") if args.out else None  # noqa: SIM115

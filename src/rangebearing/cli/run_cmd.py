@@ -9,12 +9,13 @@ import sys
 from typing import Any, Callable, Optional
 
 from ..config import Config, SourceConfig, check
-from ..daemon import Daemon
+from ..daemon.loop import Daemon
+from ..daemon.sdnotify import Notifier
 from ..errors import ConfigError
 from ..net.protocol import decode_reading
 from ..net.publisher import UdpPublisher
-from ..sdnotify import Notifier
-from ..sources.base import FrameSource, open_source
+from ..sources.base import FrameSource
+from ..sources.factory import open_source
 from .common import add_config_arg, config_from_args
 from .listen_cmd import format_reading
 

@@ -26,11 +26,11 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from ..config import DetectionConfig
 from .blobs import find_boxes, mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .pairing import PairingLimits, pair_bands
+from .params import DetectionParams
 from .refine import Pyramid, half_or_area, measure_bands
 from .types import XY, BBox, union
 
@@ -65,7 +65,7 @@ def downscale(bgr: np.ndarray, s: int) -> np.ndarray:
     return cv2.resize(bgr[: h // s * s, : w // s * s], (w // s, h // s), interpolation=half_or_area(s))
 
 
-def region_masks(small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
+def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
     """Filtered red and blue masks of a downscaled frame: balance, HSV, thresholds, majority filter."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
@@ -73,7 +73,7 @@ def region_masks(small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: i
 
 
 def find_pairs(
-    small: np.ndarray, cfg: DetectionConfig, gains: Gains, ksize: int, limits: PairingLimits, geometry
+    small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, limits: PairingLimits, geometry
 ) -> Tuple[np.ndarray, np.ndarray]:
     """Candidate landmarks in a frame downscaled by ``cfg.downscale``.
 
@@ -93,7 +93,7 @@ def refine(
     bgr: np.ndarray,
     red_boxes: np.ndarray,
     blue_boxes: np.ndarray,
-    cfg: DetectionConfig,
+    cfg: DetectionParams,
     gains: Gains,
     pyramid: Optional[Pyramid] = None,
 ) -> List[BandCentroids]:
@@ -116,7 +116,7 @@ def refine(
     return found
 
 
-def detect_paper(bgr: np.ndarray, cfg: DetectionConfig) -> List[BandCentroids]:
+def detect_paper(bgr: np.ndarray, cfg: DetectionParams) -> List[BandCentroids]:
     """The paper's pipeline as published: median over the colour frame, HSV, whole-mask moments.
 
     Finds at most one landmark: the centroid of *all* red pixels and of *all*

@@ -26,7 +26,7 @@ from typing import Tuple
 import cv2
 import numpy as np
 
-from ..config import ModelConfig
+from .params import ModelParams
 from .types import XY, CameraIntrinsics, LandmarkGeometry
 
 
@@ -65,7 +65,7 @@ def axis_bearing(bearing_c_rad: float, range_m: float, radius_m: float) -> float
 
 
 def pinhole_reading(
-    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig, geometry: LandmarkGeometry
+    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelParams, geometry: LandmarkGeometry
 ) -> Tuple[float, float, float, float, float]:
     """``(range_m, bearing_rad, d_v_m, d_h_m, l_px)`` from band centroids with the pinhole model."""
     if cam.has_distortion:
@@ -83,7 +83,7 @@ def pinhole_reading(
 
 
 def paper_reading(
-    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig
+    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelParams
 ) -> Tuple[float, float, float, float, float]:
     """``(range_m, bearing_rad, d_v_m, d_h_m, l_px)`` with the paper's equations 1–4 as published."""
     l_px = math.hypot(blue_xy[0] - red_xy[0], blue_xy[1] - red_xy[1])
@@ -95,7 +95,7 @@ def paper_reading(
 
 
 def reading(
-    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelConfig, geometry: LandmarkGeometry
+    red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelParams, geometry: LandmarkGeometry
 ) -> Tuple[float, float, float, float, float]:
     """Dispatch on ``model.kind``: ``(range_m, bearing_rad, d_v_m, d_h_m, l_px)``."""
     if model.kind == "paper":
@@ -103,7 +103,7 @@ def reading(
     return pinhole_reading(red_xy, blue_xy, cam, model, geometry)
 
 
-def in_envelope(range_m: float, bearing_rad: float, model: ModelConfig) -> bool:
+def in_envelope(range_m: float, bearing_rad: float, model: ModelParams) -> bool:
     """Whether a reading lies inside the range and bearing the model was fitted over."""
     r0, r1 = model.envelope_range_m
     b0, b1 = model.envelope_bearing_rad

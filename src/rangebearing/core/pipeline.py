@@ -13,13 +13,13 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from ..config import Config
 from ..errors import FrameError
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, find_pairs, refine
 from .model import in_envelope, reading
 from .pairing import PairingLimits
+from .params import PipelineParams
 from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark
@@ -43,17 +43,20 @@ class Pipeline:
 
     Parameters
     ----------
-    cfg : Config
-        Validated configuration (camera intrinsics, landmark, detection, model).
+    params : PipelineParams
+        Camera intrinsics, landmark geometry, detection settings and model
+        (``Config.pipeline`` of a loaded config).
     track : bool, optional
         Search only around last frame's landmarks between full-frame scans.
-        ``None`` takes ``cfg.detection.tracking``. Use ``False`` for frames
+        ``None`` takes ``params.detection.tracking``. Use ``False`` for frames
         that are not a sequence.
     """
 
-    def __init__(self, cfg: Config, track: Optional[bool] = None) -> None:
-        self.cfg = cfg
-        self.track = cfg.detection.tracking if track is None else track
+    def __init__(self, params: PipelineParams, track: Optional[bool] = None) -> None:
+        if not isinstance(params, PipelineParams):
+            raise TypeError(f"Pipeline takes PipelineParams (a config's .pipeline), not {type(params).__name__}")
+        self.params = params
+        self.track = params.detection.tracking if track is None else track
         self.limits = PairingLimits()
         self._cams: Dict[Tuple[int, int], Tuple[CameraIntrinsics, int]] = {}
         self.reset()
@@ -68,7 +71,7 @@ class Pipeline:
         """Intrinsics for this frame size and the band-preserving filter size."""
         key = (w, h)
         if key not in self._cams:
-            cam = self.cfg.camera
+            cam = self.params.camera
             if (cam.width_px, cam.height_px) != key:
                 if abs(w * cam.height_px - h * cam.width_px) > 0.01 * w * cam.height_px:
                     raise FrameError(
@@ -76,9 +79,9 @@ class Pipeline:
                         "another aspect ratio (a cropped sensor mode): configure camera.* for this resolution"
                     )
                 cam = cam.scaled(w, h)  # the same sensor area at another resolution
-            far = self.cfg.model.envelope_range_m[1]
-            band_px = cam.fy_px * self.cfg.landmark.band_height_m / far / self.cfg.detection.downscale
-            self._cams[key] = (cam, band_preserving_ksize(self.cfg.detection.median_ksize, band_px))
+            far = self.params.model.envelope_range_m[1]
+            band_px = cam.fy_px * self.params.landmark.band_height_m / far / self.params.detection.downscale
+            self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))
         return self._cams[key]
 
     def process(self, frame: np.ndarray) -> FrameResult:
@@ -92,13 +95,13 @@ class Pipeline:
         bgr = check_frame(frame)
         h, w = bgr.shape[:2]
         cam, ksize = self._camera(w, h)
-        det = self.cfg.detection
+        det = self.params.detection
         tracked = False
         if det.method == "paper":
             found = detect_paper(bgr, det)
         else:
             if self.track and self._tracks and self._since_scan < det.full_scan_every - 1:
-                self._tracks, lost = step(bgr, self._tracks, det, self._gains, self.cfg.landmark, self.limits)
+                self._tracks, lost = step(bgr, self._tracks, det, self._gains, self.params.landmark, self.limits)
                 # a lost landmark may be just outside its window: scan the whole frame next time
                 self._since_scan = det.full_scan_every if lost else self._since_scan + 1
                 found = [t.bands for t in self._tracks]
@@ -107,7 +110,7 @@ class Pipeline:
                 small = downscale(bgr, det.downscale)
                 if det.white_balance == "grey_world":
                     self._gains = grey_world_gains(small)
-                reds, blues = find_pairs(small, det, self._gains, ksize, self.limits, self.cfg.landmark)
+                reds, blues = find_pairs(small, det, self._gains, ksize, self.limits, self.params.landmark)
                 found = refine(bgr, reds, blues, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
@@ -118,7 +121,7 @@ class Pipeline:
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
 
     def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:
-        rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, self.cfg.model, self.cfg.landmark)
+        rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, self.params.model, self.params.landmark)
         return Landmark(
             range_m=rng,
             bearing_rad=bearing,
@@ -129,5 +132,5 @@ class Pipeline:
             blue_xy_px=c.blue_xy_px,
             width_px=c.width_px,
             bbox_px=c.bbox_px,
-            in_envelope=in_envelope(rng, bearing, self.cfg.model),
+            in_envelope=in_envelope(rng, bearing, self.params.model),
         )

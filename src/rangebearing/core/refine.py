@@ -15,8 +15,8 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from ..config import DetectionConfig
 from .color import Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
+from .params import DetectionParams
 from .types import XY, BBox
 
 # Bands taller than this (full-resolution pixels) are measured at 1/f resolution,
@@ -28,7 +28,7 @@ CHROMA_FLOOR = 0.15  # share of a band's mean chroma where its vertical weight s
 
 
 def band_weights(
-    hsv: np.ndarray, n_red: int, cfg: DetectionConfig, refs: Optional[np.ndarray] = None
+    hsv: np.ndarray, n_red: int, cfg: DetectionParams, refs: Optional[np.ndarray] = None
 ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weights ``(w_x, w_y)`` of a stack of band tiles, each (N, H, W): ``w_x`` uint8 0–255, ``w_y`` float32 0–1.
 
@@ -195,7 +195,7 @@ def measure_bands(
     boxes: Sequence[BBox],
     is_red: Sequence[bool],
     margins: Sequence[Margin],
-    cfg: DetectionConfig,
+    cfg: DetectionParams,
     gains: Gains,
     pyramid: Optional[Pyramid] = None,
     refs: Optional[Sequence[float]] = None,

@@ -16,10 +16,10 @@ from typing import List, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
-from ..config import DetectionConfig
 from .color import Gains
 from .detect import BandCentroids
 from .pairing import PairingLimits
+from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
 from .types import XY, BBox, LandmarkGeometry
 
@@ -86,7 +86,7 @@ def advance(old: Track, red: BandFix, blue: BandFix) -> Track:
 def step(
     bgr: np.ndarray,
     tracks: Sequence[Track],
-    cfg: DetectionConfig,
+    cfg: DetectionParams,
     gains: Gains,
     geometry: LandmarkGeometry,
     limits: PairingLimits,

@@ -8,7 +8,8 @@ config names with :func:`open_source`.
 
 from __future__ import annotations
 
-from .base import Frame, FrameSource, open_source, validate_frame
+from .base import Frame, FrameSource, validate_frame
+from .factory import open_source
 from .opencv_capture import OpenCVSource
 from .picamera2_source import Picamera2Source
 from .recorded import RecordedSource, count_recorded, iter_recorded

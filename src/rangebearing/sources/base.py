@@ -1,25 +1,21 @@
-"""The one interface every frame source implements, the frame it yields, and the factory.
+"""The one interface every frame source implements, and the frame it yields.
 
 A :class:`FrameSource` behaves like a camera: ``read()`` hands back the newest
 frame available, counting the ones it had to skip in ``dropped``. Sources are
 passed to the daemon and the CLI, never looked up from globals; the recorded
-source plays the part of gpiozero's mock pin backend.
+source plays the part of gpiozero's mock pin backend. This module imports no
+backend: :mod:`.factory` does the choosing.
 """
 
 from __future__ import annotations
 
-import time
-from typing import TYPE_CHECKING, Callable, Optional, Protocol, runtime_checkable
+from typing import Callable, Optional, Protocol, runtime_checkable
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
-from ..errors import FrameError, SourceError
-
-if TYPE_CHECKING:
-    from ..config import SourceConfig
-    from ..core.types import CameraIntrinsics
+from ..errors import FrameError
 
 
 @frozen
@@ -107,56 +103,3 @@ def validate_frame(image: object) -> np.ndarray:
 
 
 Sleep = Callable[[float], object]
-
-
-def open_source(
-    cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep = time.sleep
-) -> FrameSource:
-    """Build the source ``cfg.kind`` names, open it and return it.
-
-    ``camera`` sizes the synthetic renderer; the other sources take their size
-    from ``cfg``. Opening an already open source is a no-op, so a caller that
-    calls ``open()`` again is harmless. The caller owns the source and must
-    ``close()`` it. ``sleep`` paces recorded and synthetic frames and spaces
-    camera retries; pass ``threading.Event.wait`` so that setting the event
-    cuts any wait short (a sleep that returns True ends the wait).
-
-    Raises
-    ------
-    SourceError
-        The kind is unknown or not available, or the source cannot be opened
-        (CameraError for a missing or busy camera).
-    """
-    source: FrameSource
-    if cfg.kind == "recorded":
-        from .recorded import RecordedSource
-
-        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep)
-    elif cfg.kind == "opencv":
-        from .opencv_capture import OpenCVSource
-
-        source = OpenCVSource(
-            cfg.device, cfg.width_px, cfg.height_px, cfg.fps,
-            timeout_s=cfg.timeout_s, retries=cfg.retries,
-        )
-    elif cfg.kind == "picamera2":
-        from .picamera2_source import Picamera2Source
-
-        source = Picamera2Source(cfg, sleep=sleep)
-    elif cfg.kind == "synthetic":
-        source = _synthetic(cfg, camera, sleep)
-    else:
-        raise SourceError(f"unknown source kind {cfg.kind!r}")
-    source.open()
-    return source
-
-
-def _synthetic(cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep) -> FrameSource:
-    try:
-        from .synthetic import SyntheticSource
-    except ImportError:
-        raise SourceError(
-            "source kind 'synthetic' is not available yet (rangebearing.synth is missing); "
-            "use 'recorded' with rendered frames instead"
-        ) from None
-    return SyntheticSource(cfg, camera, sleep=sleep)

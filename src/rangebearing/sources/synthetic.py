@@ -1,6 +1,6 @@
 """Synthetic frames: a landmark moving on a known path, rendered at ``cfg.fps``.
 
-Paced like a camera (see :class:`~.recorded.Pacer`), so a slow consumer drops
+Paced like a camera (see :class:`~.pacing.Pacer`), so a slow consumer drops
 frames just as it would on the robot; :meth:`SyntheticSource.truth` gives the
 exact pose behind every frame index.
 """
@@ -20,7 +20,7 @@ from ..errors import SourceError
 from ..synth.render import render
 from ..synth.scene import LandmarkPose, Scene
 from .base import Frame
-from .recorded import Pacer
+from .pacing import Pacer
 
 Path = Callable[[float], Tuple[LandmarkPose, ...]]
 

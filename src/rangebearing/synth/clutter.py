@@ -18,7 +18,7 @@ from typing import List, Optional, Tuple, Union
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from . import _draw as d
+from . import sampling as d
 from .camera import BoxPx, cylinder_bbox_px, landmark_bbox_px, points_bbox
 from .scene import RGB, Box, Cylinder, FloorPatch, LandmarkPose, Poster, Scene
 

@@ -1,7 +1,7 @@
 """Sets of synthetic frames with their truth: in memory, or written to a folder.
 
 A folder holds ``000000.png`` … (or ``.jpg``), ``truth.csv`` (see
-:mod:`rangebearing.truth`) and ``camera.yaml``, the ``camera:`` config section
+:mod:`rangebearing.evaluation.truth`) and ``camera.yaml``, the ``camera:`` config section
 of the intrinsics the frames were rendered with (loadable with ``--config``).
 """
 
@@ -19,7 +19,7 @@ import yaml
 
 from ..core.types import CameraIntrinsics
 from ..errors import ConfigError
-from ..truth import TruthRow, write_truth
+from ..evaluation.truth import TruthRow, write_truth
 from .camera import inside_image, landmark_bbox_px
 from .presets import PRESETS, scene_sequence
 from .render import render

@@ -22,7 +22,7 @@ import numpy as np
 from .._compat import frozen
 from ..core.types import CameraIntrinsics
 from ..errors import ConfigError
-from . import _draw as d
+from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene

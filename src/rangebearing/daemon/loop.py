@@ -17,16 +17,16 @@ import threading
 import time
 from typing import Callable, Optional
 
-from .config import Config, SourceConfig, load_config
-from .core.pipeline import Pipeline
-from .errors import ConfigError, FrameError, ProtocolError, RangeBearingError, SourceError
-from .net.protocol import encode_reading
-from .net.publisher import Publisher
+from ..config import Config, SourceConfig, load_config
+from ..core.pipeline import Pipeline
+from ..errors import ConfigError, FrameError, ProtocolError, RangeBearingError, SourceError
+from ..net.protocol import encode_reading
+from ..net.publisher import Publisher
+from ..sources.base import FrameSource
 from .sdnotify import Notifier
-from .sources.base import FrameSource
 from .stats import LoopStats, Summary
 
-log = logging.getLogger("rangebearing.daemon")
+log = logging.getLogger("rangebearing.daemon.loop")
 
 SourceFactory = Callable[[Config, Callable[[float], object]], FrameSource]
 PublisherFactory = Callable[[Config], Publisher]
@@ -75,7 +75,7 @@ class Daemon:
         self._stop = threading.Event()
         self._reload = threading.Event()
         self._source: Optional[FrameSource] = None
-        self._pipe = Pipeline(cfg)
+        self._pipe = Pipeline(cfg.pipeline)
         self._publisher: Optional[Publisher] = None
         self._ready = False  # READY=1 sent: the first frame went through
         self._dropped_before = 0  # drops of sources closed by a reload
@@ -102,7 +102,7 @@ class Daemon:
     # --- the loop ---------------------------------------------------------------------
     def run(self) -> int:
         """Returns 0 when the source ends or a stop was requested, 1 when the source failed."""
-        self._pipe = Pipeline(self.cfg)
+        self._pipe = Pipeline(self.cfg.pipeline)
         self._publisher = self._open_publisher(self.cfg)
         try:
             self._source = self._open_source(self.cfg, self._stop.wait)
@@ -208,7 +208,7 @@ class Daemon:
                 new_pub.close()
                 return
             self._publisher.close()
-            self._publisher, self._pipe, self.cfg = new_pub, Pipeline(new), new
+            self._publisher, self._pipe, self.cfg = new_pub, Pipeline(new.pipeline), new
             log.info("config reloaded from %s", self.config_path)
         finally:
             if self._ready:

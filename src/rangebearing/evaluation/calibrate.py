@@ -1,7 +1,7 @@
 """Calibration from frames with known range and bearing: detect, match, fit.
 
 The library side of ``rangebearing calibrate``; the least squares live in
-:mod:`rangebearing.core.calibrate`.
+:mod:`rangebearing.core.fit`.
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ from typing import Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .config import Config
-from .core.calibrate import Fit, Sample, fit_model
-from .core.pipeline import Pipeline
-from .evaluate import match_frame
+from ..config import Config
+from ..core.fit import Fit, Sample, fit_model
+from ..core.pipeline import Pipeline
+from .match import match_frame
 from .truth import TruthRow
 
 # Before calibration the model may be far off; match detections to truth loosely.
@@ -29,7 +29,7 @@ def collect_samples(frames: Frames, cfg: Config) -> List[Sample]:
 
     Frames without truth rows or without an image are skipped.
     """
-    pipe = Pipeline(cfg, track=False)
+    pipe = Pipeline(cfg.pipeline, track=False)
     samples = []
     for name, image, rows in frames:
         if image is None or not rows:

@@ -12,8 +12,8 @@ from typing import Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
-from ..config import ModelConfig
 from ..errors import CalibrationError
+from .params import ModelParams
 
 MIN_SAMPLES = 4
 MIN_RANGE_SPREAD = 1.15  # farthest / nearest true range
@@ -53,7 +53,7 @@ class Residual:
 class Fit:
     """A fitted model, its residuals, and summary errors."""
 
-    model: ModelConfig
+    model: ModelParams
     residuals: Tuple[Residual, ...]
     range_err_pct_mean: float
     range_err_pct_max: float
@@ -80,7 +80,7 @@ def _envelope(samples: Sequence[Sample]) -> Tuple[Tuple[float, float], Tuple[flo
     return (round(min(r), 4), round(max(r), 4)), (round(min(b), 4), round(max(b), 4))
 
 
-def fit_model(samples: Sequence[Sample], base: ModelConfig) -> Fit:
+def fit_model(samples: Sequence[Sample], base: ModelParams) -> Fit:
     """Fit ``base.kind``'s coefficients and the validity envelope.
 
     pinhole: ``range = S/(L_n·cos θ) + c`` by linear least squares in (S, c).

@@ -13,8 +13,8 @@ import math
 import os
 from typing import Dict, Iterable, List, Union
 
-from ._compat import frozen
-from .errors import TruthError
+from .._compat import frozen
+from ..errors import TruthError
 
 COLUMNS = ("frame", "range_m", "bearing_rad")
 PathLike = Union[str, "os.PathLike[str]"]

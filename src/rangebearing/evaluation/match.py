@@ -7,8 +7,8 @@ from typing import Iterable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ._compat import frozen
-from .core.types import Landmark
+from .._compat import frozen
+from ..core.types import Landmark
 from .truth import TruthRow
 
 MATCH_GAP_RAD = math.radians(3.0)

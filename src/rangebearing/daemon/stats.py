@@ -7,7 +7,7 @@ from typing import Deque, Dict
 
 import numpy as np
 
-from ._compat import frozen
+from .._compat import frozen
 
 
 @frozen

@@ -7,7 +7,7 @@ import math
 import cv2
 import numpy as np
 
-from .core.types import FrameResult
+from ..core.types import FrameResult
 
 GREEN, RED, BLUE, GREY = (60, 220, 60), (40, 40, 255), (255, 120, 40), (170, 170, 170)
 

@@ -1,0 +1,163 @@
+"""The configuration's shape: one frozen dataclass per YAML section, and the per-key checks.
+
+The four sections the pipeline needs (camera, landmark, detection, model) are
+the core's own parameter types (:mod:`rangebearing.core.params`); the rest
+(source, publish, daemon) belong to the application shell.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, Tuple
+
+from .._compat import frozen
+from ..core.params import METHODS, MODELS, WHITE_BALANCE, DetectionParams, ModelParams, PipelineParams
+from ..core.types import CameraIntrinsics, LandmarkGeometry
+from . import checks as ck
+
+DEFAULT_PORT = 47800
+SOURCES = ("recorded", "opencv", "picamera2", "synthetic")
+
+
+@frozen
+class SourceConfig:
+    """Where frames come from (the daemon and ``record``)."""
+
+    kind: str = "picamera2"
+    path: str = ""
+    fps: float = 30.0
+    loop: bool = False
+    device: str = "0"
+    camera_num: int = 0
+    width_px: int = 640
+    height_px: int = 480
+    hflip: bool = False
+    vflip: bool = False
+    buffer_count: int = 4
+    timeout_s: float = 2.0
+    retries: int = 5
+    controls: Tuple[Tuple[str, Any], ...] = ()
+
+
+@frozen
+class PublishConfig:
+    """Where readings go: unicast destinations and an opt-in multicast group."""
+
+    robot_id: str = "zumo"
+    unicast: Tuple[Tuple[str, int], ...] = (("127.0.0.1", DEFAULT_PORT),)
+    multicast_group: str = ""
+    multicast_port: int = DEFAULT_PORT
+    multicast_ttl: int = 1
+    multicast_interface: str = "127.0.0.1"
+
+
+@frozen
+class DaemonConfig:
+    """The capture loop's housekeeping."""
+
+    status_interval_s: float = 5.0
+    echo: bool = False
+
+
+@frozen
+class Config:
+    """The whole validated configuration."""
+
+    camera: CameraIntrinsics = CameraIntrinsics()
+    landmark: LandmarkGeometry = LandmarkGeometry()
+    detection: DetectionParams = DetectionParams()
+    model: ModelParams = ModelParams()
+    source: SourceConfig = SourceConfig()
+    publish: PublishConfig = PublishConfig()
+    daemon: DaemonConfig = DaemonConfig()
+    source_file: str = "<defaults>"
+
+    @property
+    def pipeline(self) -> PipelineParams:
+        """What the pipeline needs: camera, landmark, detection and model."""
+        return PipelineParams(self.camera, self.landmark, self.detection, self.model)
+
+
+SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
+    "camera": (
+        CameraIntrinsics,
+        {
+            "width_px": ck.positive(True),
+            "height_px": ck.positive(True),
+            "fx_px": ck.positive(),
+            "fy_px": ck.positive(),
+            "cx_px": ck.number(0, 10000),
+            "cy_px": ck.number(0, 10000),
+            "distortion": ck.distortion,
+        },
+    ),
+    "landmark": (
+        LandmarkGeometry,
+        {
+            "height_m": ck.positive(),
+            "diameter_m": ck.positive(),
+            "band_height_m": ck.positive(),
+        },
+    ),
+    "detection": (
+        DetectionParams,
+        {
+            "method": ck.choice(*METHODS),
+            "median_ksize": ck.odd_ksize,
+            "downscale": ck.number(1, 4, integer=True),
+            "white_balance": ck.choice(*WHITE_BALANCE),
+            "red_hue": ck.hue_ranges,
+            "blue_hue": ck.hue_ranges,
+            "s_min": ck.number(0, 255, integer=True),
+            "v_min": ck.number(0, 255, integer=True),
+            "min_band_px": ck.number(1, 100),
+            "max_landmarks": ck.positive(True),
+            "tracking": ck.boolean,
+            "full_scan_every": ck.positive(True),
+        },
+    ),
+    "model": (
+        ModelParams,
+        {
+            "kind": ck.choice(*MODELS),
+            "spacing_m": ck.positive(),
+            "c_m": ck.number(-0.5, 0.5),
+            "k_px_m": ck.positive(),
+            "kh_m_per_px": ck.positive(),
+            "cylinder_correction": ck.boolean,
+            "envelope_range_m": ck.pair(0, 100),
+            "envelope_bearing_rad": ck.pair(-math.pi, math.pi),
+        },
+    ),
+    "source": (
+        SourceConfig,
+        {
+            "kind": ck.choice(*SOURCES),
+            "path": ck.string,
+            "fps": ck.number(0, 1000),
+            "loop": ck.boolean,
+            "device": ck.string,
+            "camera_num": ck.number(0, 16, integer=True),
+            "width_px": ck.positive(True),
+            "height_px": ck.positive(True),
+            "hflip": ck.boolean,
+            "vflip": ck.boolean,
+            "buffer_count": ck.number(1, 16, integer=True),
+            "timeout_s": ck.positive(),
+            "retries": ck.number(0, 1000, integer=True),
+            "controls": ck.controls,
+        },
+    ),
+    "publish": (
+        PublishConfig,
+        {
+            "robot_id": ck.string,
+            "unicast": ck.destinations,
+            "multicast_group": ck.string,
+            "multicast_port": ck.number(1, 65535, integer=True),
+            "multicast_ttl": ck.number(0, 255, integer=True),
+            "multicast_interface": ck.string,
+        },
+    ),
+    "daemon": (DaemonConfig, {"status_interval_s": ck.positive(), "echo": ck.boolean}),
+}
