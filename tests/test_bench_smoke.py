@@ -99,7 +99,8 @@ def test_quick_run_judges_every_target(quick_run):
     proc, _ = quick_run
     rows = table_after(proc.stdout, "## Targets")
     assert len(rows) == 6
-    assert all(r["result"].split()[0] in ("PASS", "MISS", "INVALID", "n/a") for r in rows)
+    # INVALID means a contender missed landmarks it should have found: its time would mean nothing
+    assert all(r["result"].split()[0] in ("PASS", "MISS", "n/a") for r in rows), rows
 
 
 def test_out_file_has_the_machine_header_the_command_and_the_tables(quick_run):

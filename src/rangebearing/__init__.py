@@ -2,7 +2,7 @@
 
 >>> import rangebearing
 >>> cfg = rangebearing.load_config(None)          # built-in defaults
->>> pipe = rangebearing.Pipeline(cfg)
+>>> pipe = rangebearing.Pipeline(cfg.pipeline)    # camera, landmark, detection, model
 >>> result = pipe.process(frame_bgr)              # doctest: +SKIP
 >>> [(lm.range_m, lm.bearing_rad) for lm in result.landmarks]  # doctest: +SKIP
 """
@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 from .config import Config, load_config
+from .core.params import DetectionParams, ModelParams, PipelineParams
 from .core.pipeline import Pipeline
 from .core.types import CameraIntrinsics, FrameResult, Landmark, LandmarkGeometry
 from .errors import (
@@ -30,11 +31,14 @@ __all__ = [
     "CameraIntrinsics",
     "Config",
     "ConfigError",
+    "DetectionParams",
     "FrameError",
     "FrameResult",
     "Landmark",
     "LandmarkGeometry",
+    "ModelParams",
     "Pipeline",
+    "PipelineParams",
     "ProtocolError",
     "RangeBearingError",
     "SourceError",

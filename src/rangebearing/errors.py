@@ -11,15 +11,22 @@ class RangeBearingError(Exception):
     """Root of every error rangebearing raises on purpose."""
 
 
-class ConfigError(RangeBearingError, ValueError):
-    """A configuration file or value is invalid; the message names every problem."""
+class _Problems(Exception):
+    """Mixin: an error that lists every problem found at once, under the name of what holds them."""
 
-    def __init__(self, problems: list[str] | str, source: str = "<config>") -> None:
+    def __init__(self, problems: list[str] | str, source: str) -> None:
         self.problems = [problems] if isinstance(problems, str) else list(problems)
         self.source = source
         lines = "\n".join(f"  - {p}" for p in self.problems)
         n = len(self.problems)
         super().__init__(f"{source}: {n} problem{'s' if n != 1 else ''}:\n{lines}")
+
+
+class ConfigError(_Problems, RangeBearingError, ValueError):
+    """A configuration file or value is invalid; the message names every problem."""
+
+    def __init__(self, problems: list[str] | str, source: str = "<config>") -> None:
+        super().__init__(problems, source)
 
 
 class FrameError(RangeBearingError, ValueError):
@@ -38,9 +45,32 @@ class CalibrationError(RangeBearingError, ValueError):
     """The calibration data cannot support a fit."""
 
 
+class SceneError(_Problems, RangeBearingError, ValueError):
+    """A synthetic scene or preset cannot be built as asked; the message names every problem."""
+
+    def __init__(self, problems: list[str] | str, source: str = "synth") -> None:
+        super().__init__(problems, source)
+
+
+class PublishError(RangeBearingError, OSError):
+    """Readings cannot be published: a destination does not resolve or a socket cannot be set up."""
+
+
+class SubscribeError(RangeBearingError, OSError):
+    """A subscriber cannot bind or join: a bad address, group or port."""
+
+
+class NoReadingError(RangeBearingError, TimeoutError):
+    """No valid reading arrived within the time a listener was told to wait."""
+
+
 class ProtocolError(RangeBearingError, ValueError):
     """A datagram is not a valid rangebearing reading."""
 
 
 class TruthError(RangeBearingError, ValueError):
     """A ground-truth file is malformed."""
+
+
+class OutputError(RangeBearingError, OSError):
+    """A file or folder the command was asked to write cannot be written."""

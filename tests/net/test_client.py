@@ -8,7 +8,7 @@ from typing import Iterator
 
 import pytest
 
-from rangebearing.errors import ConfigError
+from rangebearing.errors import SubscribeError
 from rangebearing.net.client import Subscriber
 from rangebearing.net.protocol import encode_reading
 
@@ -103,7 +103,7 @@ def test_bad_group_is_a_config_error(group: str, monkeypatch: pytest.MonkeyPatch
         return host
 
     monkeypatch.setattr(socket, "gethostbyname", no_dns)
-    with pytest.raises(ConfigError, match="group"):
+    with pytest.raises(SubscribeError, match="group"):
         Subscriber(port=0, group=group)
 
 

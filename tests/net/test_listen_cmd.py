@@ -12,6 +12,7 @@ from typing import Iterator, List
 import pytest
 
 from rangebearing.cli import listen_cmd
+from rangebearing.cli.main import main
 from rangebearing.net.client import Subscriber
 from rangebearing.net.protocol import Reading, RemoteLandmark, decode_reading, encode_reading
 
@@ -108,8 +109,7 @@ def test_run_prints_a_received_reading(tx: socket.socket,
 
 
 def test_run_times_out_with_a_clear_error(capsys: pytest.CaptureFixture[str]) -> None:
-    args = _parse(["listen", "--port", str(_free_port()), "--timeout", "0.05"])
-    assert listen_cmd.run(args) == 1
+    assert main(["listen", "--port", str(_free_port()), "--timeout", "0.05"]) == 1
     err = capsys.readouterr().err
     assert err.startswith("rangebearing: error: no reading arrived on 127.0.0.1:")
     assert "0.05 s" in err
@@ -117,12 +117,12 @@ def test_run_times_out_with_a_clear_error(capsys: pytest.CaptureFixture[str]) ->
 
 def test_run_reports_a_busy_port(capsys: pytest.CaptureFixture[str]) -> None:
     with Subscriber(port=0) as busy:
-        assert listen_cmd.run(_parse(["listen", "--port", str(busy.port)])) == 1
+        assert main(["listen", "--port", str(busy.port)]) == 1
     assert "rangebearing: error: cannot listen on 127.0.0.1:" in capsys.readouterr().err
 
 
 def test_interface_needs_a_group(capsys: pytest.CaptureFixture[str]) -> None:
-    assert listen_cmd.run(_parse(["listen", "--interface", "127.0.0.1"])) == 1
+    assert main(["listen", "--interface", "127.0.0.1"]) == 2
     assert "--interface only applies with --group" in capsys.readouterr().err
 
 

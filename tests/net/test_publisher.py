@@ -9,7 +9,7 @@ from typing import Any, Iterator, List
 import pytest
 
 from rangebearing.config import PublishConfig
-from rangebearing.errors import ConfigError
+from rangebearing.errors import PublishError
 from rangebearing.net.client import Subscriber
 from rangebearing.net.protocol import encode_reading
 from rangebearing.net.publisher import MemoryPublisher, Publisher, UdpPublisher
@@ -140,13 +140,13 @@ def test_unresolvable_host_is_a_config_error(monkeypatch: pytest.MonkeyPatch) ->
 
     monkeypatch.setattr(socket, "getaddrinfo", fake)
     cfg = PublishConfig(unicast=(("127.0.0.1", 47800), ("no-such-robot.invalid", 47800)))
-    with pytest.raises(ConfigError, match=r"no-such-robot\.invalid"):
+    with pytest.raises(PublishError, match=r"no-such-robot\.invalid"):
         UdpPublisher(cfg)
 
 
 def test_multicast_interface_that_is_not_local_is_a_config_error() -> None:
     cfg = PublishConfig(unicast=(), multicast_group=GROUP, multicast_interface="192.0.2.1")
-    with pytest.raises(ConfigError, match="multicast_interface"):
+    with pytest.raises(PublishError, match="multicast_interface"):
         UdpPublisher(cfg)
 
 

@@ -9,7 +9,7 @@ from typing import Any, Dict
 import pytest
 
 import rangebearing.net.protocol as protocol
-from rangebearing.cli.listen_cmd import format_reading
+from rangebearing.cli.common import format_reading
 from rangebearing.net.protocol import decode_reading, encode_reading
 
 from .factories import make_landmark

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rangebearing.core.types import CameraIntrinsics
-from rangebearing.errors import ConfigError
+from rangebearing.errors import SceneError
 from rangebearing.synth import LandmarkPose, Lighting, Scene, landmark_bbox_px, project, ray_grid, render_linear
 from rangebearing.synth.camera import inside_image
 from rangebearing.synth.sampling import bearing_limits
@@ -91,7 +91,7 @@ def test_project_inverts_the_grid_and_is_nan_behind():
 
 
 def test_unsupported_distortion_is_a_config_error():
-    with pytest.raises(ConfigError, match="coefficients"):
+    with pytest.raises(SceneError, match="coefficients"):
         ray_grid(dataclasses.replace(CAM, distortion=(0.1,) * 12))
 
 

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from rangebearing.cli import synth_cmd
+from rangebearing.cli.main import main
 from rangebearing.config import load_config
 from rangebearing.core.types import CameraIntrinsics
-from rangebearing.errors import ConfigError
+from rangebearing.errors import SceneError
 from rangebearing.evaluation.truth import read_truth
 from rangebearing.synth import LandmarkPose, Scene, generate, scene_truth, write_dataset
 
@@ -76,7 +77,7 @@ def test_refuses_stale_frames_unless_overwrite(tmp_path):
 ])
 def test_bad_arguments(tmp_path, kwargs, word):
     args = {"frames": 1, "seed": 0, **kwargs}
-    with pytest.raises(ConfigError, match=word):
+    with pytest.raises(SceneError, match=word):
         write_dataset(tmp_path, **args)
     assert not list(tmp_path.iterdir())
 
@@ -112,12 +113,11 @@ def test_command_writes_a_dataset_and_prints_one_line(tmp_path, capsys):
 
 def test_command_refuses_a_used_folder(tmp_path, capsys):
     argv = ["synth", "--out", str(tmp_path), "--frames", "1", "--seed", "1"]
-    args = parser().parse_args(argv)
-    assert args.func(args) == 0
-    assert args.func(args) == 1
-    assert "--overwrite" in capsys.readouterr().err
-    args = parser().parse_args([*argv, "--overwrite"])
-    assert args.func(args) == 0
+    assert main(argv) == 0
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("rangebearing: error: ") and "--overwrite" in err and "Traceback" not in err
+    assert main([*argv, "--overwrite"]) == 0
 
 
 @pytest.mark.parametrize("bad", [

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rangebearing.core.types import CameraIntrinsics
-from rangebearing.errors import ConfigError
+from rangebearing.errors import SceneError
 from rangebearing.synth import (
     PRESETS,
     LandmarkPose,
@@ -154,15 +154,15 @@ def test_presets_follow_the_camera():
 
 
 def test_unknown_preset_and_impossible_camera():
-    with pytest.raises(ConfigError, match="unknown preset"):
+    with pytest.raises(SceneError, match="unknown preset"):
         random_scene(np.random.default_rng(0), "nope")
     tiny = CameraIntrinsics(width_px=8, height_px=6, fx_px=4.0, fy_px=4.0, cx_px=3.5, cy_px=2.5)
-    with pytest.raises(ConfigError, match="cannot place"):
+    with pytest.raises(SceneError, match="cannot place"):
         random_scene(np.random.default_rng(0), "paper", tiny)
 
 
 def test_explicit_scene_validation():
-    with pytest.raises(ConfigError, match="range_m"):
+    with pytest.raises(SceneError, match="range_m"):
         Scene(landmarks=(LandmarkPose(-1.0, 0.0),))
-    with pytest.raises(ConfigError, match="camera_height_m"):
+    with pytest.raises(SceneError, match="camera_height_m"):
         Scene(camera_height_m=0.0)

@@ -10,7 +10,7 @@ from typing import Any
 
 from ..config import dump_config
 from ..core.fit import Fit
-from ..errors import CalibrationError, RangeBearingError
+from ..errors import OutputError
 from ..evaluation.calibrate import calibrate
 from ..evaluation.truth import read_truth
 from ..sources.recorded import count_recorded, iter_recorded
@@ -59,7 +59,7 @@ def plot_fit(fit: Fit, path: str) -> None:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise RangeBearingError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
+        raise OutputError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
     true = [r.range_m for r in fit.residuals]
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
     a.plot(true, [r.fitted_range_m for r in fit.residuals], "o", ms=3)
@@ -69,8 +69,12 @@ def plot_fit(fit: Fit, path: str) -> None:
     b.axhline(0, color="k", lw=1)
     b.set(xlabel="true range (m)", ylabel="range residual (%)", title="residuals")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    try:
+        fig.savefig(path, dpi=100)
+    except OSError as exc:
+        raise OutputError(f"--plot: cannot write {path}: {exc.strerror or exc}") from None
+    finally:
+        plt.close(fig)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -85,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         out.write_text(header + dump_config(new_cfg), encoding="utf-8")
     except OSError as exc:
-        raise CalibrationError(f"cannot write {out}: {exc.strerror or exc}") from None
+        raise OutputError(f"--out: cannot write {out}: {exc.strerror or exc}") from None
     print(f"wrote {out}", file=sys.stderr)
     if args.plot:
         plot_fit(fit, args.plot)

@@ -6,14 +6,13 @@ import argparse
 import io
 import json
 import math
-import os
 import sys
 from typing import Any, Optional, TextIO
 
 from ..config import DEFAULT_PORT
+from ..errors import ConfigError, NoReadingError, SubscribeError
 from ..net.client import Subscriber
-from ..net.protocol import Reading
-from .common import describe
+from .common import format_reading
 
 DESCRIPTION = """\
 Listen for rangebearing readings and print one line per frame:
@@ -81,50 +80,6 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def printable(text: str) -> str:
-    """``text`` safe for a terminal: control characters, lone surrogates and other
-    non-printables (and the backslash itself) written as ``\\x1b``, ``\\u202e``, ``\\\\``.
-
-    Robot ids come from the network: raw, a newline would fake a reading line and an
-    ANSI escape would drive the terminal.
-    """
-    if text.isprintable() and "\\" not in text:
-        return text
-    out = []
-    for ch in text:
-        code = ord(ch)
-        if ch == "\\":
-            out.append("\\\\")
-        elif ch.isprintable():
-            out.append(ch)
-        elif code < 0x100:
-            out.append(f"\\x{code:02x}")
-        elif code < 0x10000:
-            out.append(f"\\u{code:04x}")
-        else:
-            out.append(f"\\U{code:08x}")
-    return "".join(out)
-
-
-def format_reading(reading: Reading) -> str:
-    """One human-readable line for one reading (the robot id escaped by :func:`printable`)."""
-    n = len(reading.landmarks)
-    head = f"{printable(reading.robot)} #{reading.seq} t={reading.t:.3f}  {n} landmark{'' if n == 1 else 's'}"
-    parts = [describe(lm) for lm in reading.landmarks]
-    line = f"{head}: {' | '.join(parts)}" if parts else head
-    extras = []
-    if reading.fps is not None:
-        extras.append(f"{reading.fps:.1f} fps")
-    if reading.dropped:
-        extras.append(f"{reading.dropped} dropped")
-    return f"{line}  [{', '.join(extras)}]" if extras else line
-
-
-def _error(message: str) -> int:
-    print(f"rangebearing: error: {message}", file=sys.stderr, flush=True)
-    return 1
-
-
 def _one_line_json(data: bytes) -> str:
     text = data.decode("utf-8").strip()
     if not (text.isascii() and text.isprintable()):
@@ -141,13 +96,19 @@ def echo(
     count: Optional[int] = None,
     timeout_s: Optional[float] = None,
 ) -> int:
-    """Print readings from ``sub`` to ``out``; 0 after ``count`` readings, 1 on a timeout."""
+    """Print readings from ``sub`` to ``out``; 0 after ``count`` readings.
+
+    Raises
+    ------
+    NoReadingError
+        Nothing valid arrived within ``timeout_s``.
+    """
     shown = 0
     while count is None or shown < count:
         got = sub.recv_datagram(timeout_s)
         if got is None:
             where = f"{sub.group or sub.address[0]}:{sub.port}"
-            return _error(
+            raise NoReadingError(
                 f"no reading arrived on {where} within {timeout_s:g} s"
                 + (f" ({sub.dropped} invalid datagrams dropped)" if sub.dropped else "")
             )
@@ -161,22 +122,18 @@ def echo(
 def run(args: argparse.Namespace) -> int:
     """Run ``rangebearing listen`` with parsed arguments; returns the exit status."""
     if args.interface is not None and not args.group:
-        return _error("--interface only applies with --group")
+        raise ConfigError(["--interface only applies with --group"], "command line")
     where = f"{args.group or args.host}:{args.port}"
     try:
         sub = Subscriber(port=args.port, host=args.host, group=args.group, interface=args.interface or "127.0.0.1")
+    except SubscribeError:
+        raise
     except OSError as exc:
-        return _error(f"cannot listen on {where}: {exc.strerror or exc}")
+        raise SubscribeError(f"cannot listen on {where}: {exc.strerror or exc}") from None
     if isinstance(sys.stdout, io.TextIOWrapper):  # a terminal that cannot show a character gets an escape
         sys.stdout.reconfigure(errors="backslashreplace")
     try:
         with sub:
             return echo(sub, sys.stdout, args.json, args.count, args.timeout)
-    except KeyboardInterrupt:
-        return 0
-    except BrokenPipeError:
-        # The reader (e.g. `| head`) went away: stop quietly, and point stdout
-        # at /dev/null so the interpreter's final flush does not complain.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
+    except KeyboardInterrupt:  # Ctrl-C is how a user ends listening: not a failure
         return 0

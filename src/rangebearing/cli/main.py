@@ -1,62 +1,138 @@
-"""``rangebearing`` entry point: parse, dispatch, and turn errors into one clear line."""
+"""``rangebearing`` entry point: parse, dispatch, and turn every error into one clear line.
+
+The one error funnel (gpiozero's ``CliTool.__call__`` is the model): commands
+raise, and only :func:`main` prints ``rangebearing: error: …`` and picks the
+exit status. The traceback is shown only with ``--debug`` or
+``RANGEBEARING_DEBUG=1``. Each command's module is imported only when that
+command runs, so ``rangebearing run`` on a Pi never loads the renderer, the
+evaluation code or the calibration fit.
+"""
 
 from __future__ import annotations
 
 import argparse
 import importlib
 import logging
+import os
 import sys
-from typing import List, Optional
+from typing import Dict, List, Optional
 
 from .. import __version__
 from ..errors import ConfigError, RangeBearingError
 
-# Each module exposes register(subparsers) and sets func=run on its parser.
-COMMANDS = ("run", "replay", "calibrate", "synth", "record", "listen")
+# name -> one-line help; the module cli/<name>_cmd.py has register(subparsers) and sets func=run.
+COMMANDS: Dict[str, str] = {
+    "run": "run the daemon: camera → pipeline → UDP readings",
+    "listen": "print readings published by rangebearing daemons",
+    "replay": "run the pipeline over recorded frames",
+    "calibrate": "fit the range model to frames with known range and bearing",
+    "record": "save frames from a source as numbered images",
+    "synth": "render synthetic frames with exact ground truth",
+}
+
+EXIT_ERROR = 1
+EXIT_CONFIG = 2  # a bad config or command line, as argparse does
+EXIT_INTERRUPTED = 130
 
 
-def build_parser() -> argparse.ArgumentParser:
+def common_options() -> argparse.ArgumentParser:
+    """Options accepted both before and after the command name (``rangebearing -v run`` = ``run -v``)."""
+    p = argparse.ArgumentParser(add_help=False)
+    p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="log debug messages")
+    p.add_argument(
+        "--debug", action="store_true", default=argparse.SUPPRESS, help="show the traceback of an error"
+    )
+    return p
+
+
+def chosen_command(argv: List[str]) -> Optional[str]:
+    """The command named in ``argv``: the first argument that is not an option."""
+    for arg in argv:
+        if arg == "--":
+            return None
+        if not arg.startswith("-"):
+            return arg if arg in COMMANDS else None
+    return None
+
+
+def build_parser(argv: Optional[List[str]] = None) -> argparse.ArgumentParser:
+    """The parser; only the command named in ``argv`` (all of them when ``None``) is imported."""
+    common = common_options()
     parser = argparse.ArgumentParser(
         prog="rangebearing",
         description="Range and bearing to red/blue cylinder landmarks, from a camera or recorded frames.",
         epilog="Run 'rangebearing COMMAND --help' for each command's options.",
+        parents=[common],
     )
     parser.add_argument("--version", action="version", version=f"rangebearing {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log debug messages")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMANDS:
-        try:
+    wanted = chosen_command(argv) if argv is not None else None
+    for name, help_text in COMMANDS.items():
+        if argv is None or name == wanted:
             module = importlib.import_module(f".{name}_cmd", __package__)
-        except ModuleNotFoundError as exc:  # a command whose module is not in this build
-            if exc.name != f"{__package__}.{name}_cmd":
-                raise
-            continue
-        module.register(sub)
+            module.register(_WithCommon(sub, common))
+        else:  # listed in --help, not imported
+            sub.add_parser(name, help=help_text, add_help=False)
     return parser
+
+
+class _WithCommon:
+    """Wraps ``add_subparsers()`` so every command also takes the common options."""
+
+    def __init__(self, sub: argparse._SubParsersAction, common: argparse.ArgumentParser) -> None:
+        self._sub, self._common = sub, common
+
+    def add_parser(self, name: str, **kwargs: object) -> argparse.ArgumentParser:
+        parents = [*kwargs.pop("parents", []), self._common]  # type: ignore[misc]
+        return self._sub.add_parser(name, parents=parents, **kwargs)  # type: ignore[arg-type]
+
+
+def describe_error(exc: BaseException) -> str:
+    """One line (or one block, for a config's problem list) that tells a user what went wrong."""
+    if isinstance(exc, RangeBearingError):
+        return str(exc)
+    if isinstance(exc, OSError):
+        where = " ".join(f"{f}:" for f in (exc.filename, exc.filename2) if f)
+        what = exc.strerror or str(exc) or type(exc).__name__
+        return f"{where} {what}" if where else what
+    if isinstance(exc, MemoryError):
+        return "out of memory"
+    return f"{type(exc).__name__}: {exc} (a bug? rerun with --debug and report the traceback)"
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(args_list)
+    args = parser.parse_args(args_list)
+    debug = getattr(args, "debug", False) or os.environ.get("RANGEBEARING_DEBUG", "") not in ("", "0")
     logging.basicConfig(
-        level=logging.DEBUG if args.verbose else logging.INFO,
+        level=logging.DEBUG if getattr(args, "verbose", False) else logging.INFO,
         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
         stream=sys.stderr,
     )
     try:
         return int(args.func(args) or 0)
-    except RangeBearingError as exc:
-        if args.debug:
-            raise
-        print(f"rangebearing: error: {exc}", file=sys.stderr)
-        return 2 if isinstance(exc, ConfigError) else 1
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
+        _silence_stdout()
         return 0
+    except Exception as exc:
+        if debug:
+            raise
+        print(f"rangebearing: error: {describe_error(exc)}", file=sys.stderr, flush=True)
+        return EXIT_CONFIG if isinstance(exc, ConfigError) else EXIT_ERROR
+
+
+def _silence_stdout() -> None:
+    """The reader (``| head``) went away: point stdout at /dev/null so the final flush is quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":

@@ -16,8 +16,7 @@ import cv2
 from ..config import check
 from ..errors import FrameError, SourceError
 from ..sources.factory import open_source
-from .common import add_config_arg, config_from_args
-from .run_cmd import add_source_args, source_from_args
+from .common import add_config_arg, add_source_args, config_from_args, source_from_args
 
 
 def register(sub: Any) -> None:

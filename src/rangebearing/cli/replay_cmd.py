@@ -12,7 +12,7 @@ import cv2
 
 from ..core.pipeline import Pipeline
 from ..core.types import Landmark
-from ..errors import FrameError, SourceError
+from ..errors import FrameError, OutputError, SourceError
 from ..evaluation.annotate import annotate
 from ..evaluation.match import accuracy, format_report
 from ..evaluation.truth import read_truth
@@ -44,10 +44,18 @@ def run(args: argparse.Namespace) -> int:
     pipe = Pipeline(cfg.pipeline, track=args.track)
     path = Path(args.path)
     is_video = path.is_file()
-    out = open(args.out, "w", encoding="utf-8") if args.out else None  # noqa: SIM115
     ann_dir = Path(args.annotate) if args.annotate else None
     if ann_dir:
-        ann_dir.mkdir(parents=True, exist_ok=True)
+        if ann_dir.exists() and not ann_dir.is_dir():
+            raise OutputError(f"--annotate: {ann_dir} exists and is not a folder")
+        try:
+            ann_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"--annotate: cannot create {ann_dir}: {exc.strerror or exc}") from None
+    try:
+        out = open(args.out, "w", encoding="utf-8") if args.out else None  # noqa: SIM115
+    except OSError as exc:
+        raise OutputError(f"--out: cannot write {args.out}: {exc.strerror or exc}") from None
     evaluated: List[Tuple[str, Tuple[Landmark, ...], list]] = []
     bad = 0
     try:
@@ -72,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{name}: " + (" | ".join(describe(lm) for lm in result.landmarks) or "-"), flush=True)
             if ann_dir:
                 stem = Path(name).stem if not is_video else f"{int(name):06d}"
-                cv2.imwrite(str(ann_dir / f"{stem}.png"), annotate(image, result))
+                if not cv2.imwrite(str(ann_dir / f"{stem}.png"), annotate(image, result)):
+                    raise OutputError(f"--annotate: cannot write {ann_dir / f'{stem}.png'}")
             if truth is not None:
                 evaluated.append((name, result.landmarks, truth.get(name, [])))
     finally:

@@ -8,16 +8,15 @@ import logging
 import sys
 from typing import Any, Callable, Optional
 
-from ..config import Config, SourceConfig, check
+from ..config import Config, check
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
-from ..errors import ConfigError
+from ..errors import ConfigError, PublishError
 from ..net.protocol import decode_reading
 from ..net.publisher import UdpPublisher
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
-from .common import add_config_arg, config_from_args
-from .listen_cmd import format_reading
+from .common import add_config_arg, add_source_args, config_from_args, format_reading, source_from_args
 
 log = logging.getLogger("rangebearing.run")
 
@@ -38,44 +37,6 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def add_source_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--source",
-        metavar="SPEC",
-        help="override the config's source: picamera2[:N], opencv:DEVICE (index, /dev/videoN, file, URL), "
-        "synthetic, or a directory of images / video file (recorded)",
-    )
-    p.add_argument("--fps", type=float, help="frame rate (recorded frames: pace; 0 = as fast as possible)")
-    p.add_argument("--loop", action="store_true", help="recorded frames: start again at the end")
-
-
-def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[SourceConfig]:
-    """The source named on the command line, or ``None`` when none was given."""
-    spec, fps, loop = getattr(args, "source", None), getattr(args, "fps", None), getattr(args, "loop", False)
-    if spec is None and fps is None and not loop:
-        return None
-    src = base
-    if spec:
-        kind, _, rest = spec.partition(":")
-        if kind == "picamera2":
-            if rest and not rest.isdigit():
-                raise ConfigError([f"--source: {spec!r}: the camera number must be an integer"], "command line")
-            src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest else src.camera_num)
-        elif kind == "opencv":
-            src = dataclasses.replace(src, kind="opencv", device=rest or src.device)
-        elif kind == "synthetic":
-            src = dataclasses.replace(src, kind="synthetic")
-        else:
-            src = dataclasses.replace(src, kind="recorded", path=rest if kind == "recorded" else spec)
-    if fps is not None:
-        if fps < 0:
-            raise ConfigError(["--fps: must be >= 0"], "command line")
-        src = dataclasses.replace(src, fps=fps)
-    if loop:
-        src = dataclasses.replace(src, loop=True)
-    return src
-
-
 def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
     return open_source(cfg.source, cfg.camera, sleep=sleep)
 
@@ -84,8 +45,24 @@ def publisher_for(cfg: Config) -> UdpPublisher:
     """The UDP publisher; a destination that does not resolve is a problem of the config file."""
     try:
         return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
-    except ConfigError as exc:
-        raise ConfigError(exc.problems, cfg.source_file) from None
+    except PublishError as exc:
+        raise ConfigError([str(exc)], cfg.source_file) from None
+
+
+def reloader(args: argparse.Namespace) -> Optional[Callable[[], Config]]:
+    """What SIGHUP means: re-read ``--config``, the command line's own source still winning."""
+    if not args.config:
+        return None
+
+    def reload() -> Config:
+        new = config_from_args(args)
+        override = source_from_args(args, new.source)
+        if override is not None:
+            new = dataclasses.replace(new, source=override)
+            check(new)
+        return new
+
+    return reload
 
 
 def run(args: argparse.Namespace) -> int:
@@ -101,9 +78,7 @@ def run(args: argparse.Namespace) -> int:
     echo = None
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
-    daemon = Daemon(
-        cfg, source_opener, publisher_for, Notifier(), config_path=args.config, echo=echo, source_override=override
-    )
+    daemon = Daemon(cfg, source_opener, publisher_for, Notifier(), reload=reloader(args), echo=echo)
     daemon.install_signal_handlers()
     dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)
     if cfg.publish.multicast_group:

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import sys
 import time
 from typing import Any, Tuple
 
 from ..core.types import CameraIntrinsics
+from ..errors import OutputError
 from ..synth.dataset import CAMERA_FILE, FORMATS, TRUTH_FILE, write_dataset
 from ..synth.presets import PRESETS
 
@@ -99,11 +99,7 @@ def run(args: argparse.Namespace) -> int:
             args.out, args.frames, args.seed, args.preset, args.fmt, args.jpeg_quality, camera, overwrite=args.overwrite
         )
     except FileExistsError as exc:
-        print(f"rangebearing: error: {exc} (--overwrite replaces them)", file=sys.stderr)
-        return 1
-    except OSError as exc:
-        print(f"rangebearing: error: {exc}", file=sys.stderr)
-        return 1
+        raise OutputError(f"{exc} (--overwrite replaces them)") from None
     seconds = time.perf_counter() - start
     with_landmark = len({row.frame for row in truth})
     print(

@@ -6,6 +6,7 @@ ValueError with a short reason that the loader prefixes with the key.
 
 from __future__ import annotations
 
+import ipaddress
 import math
 from typing import Any, Callable, Mapping, Tuple
 
@@ -119,3 +120,11 @@ def controls(v: Any) -> Tuple[Tuple[str, Any], ...]:
             val = tuple(val)
         out.append((key, val))
     return tuple(out)
+
+
+def is_ipv4_multicast(text: str) -> bool:
+    """True for a dotted-quad IPv4 multicast address (224.0.0.0/4), such as ``239.255.47.80``."""
+    try:
+        return ipaddress.IPv4Address(text).is_multicast
+    except (ipaddress.AddressValueError, ValueError):
+        return False

@@ -14,6 +14,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Tuple, Union
 import yaml
 
 from ..errors import ConfigError
+from . import checks as ck
 from .schema import SCHEMA, Config
 
 
@@ -80,10 +81,8 @@ def _cross_checks(cfg: Config) -> list[str]:
         p.append("landmark.band_height_m: two bands do not fit in landmark.height_m")
     if cfg.source.kind in ("recorded",) and not cfg.source.path:
         p.append("source.path: required when source.kind is 'recorded'")
-    if cfg.publish.multicast_group:
-        parts = cfg.publish.multicast_group.split(".")
-        if len(parts) != 4 or not all(x.isdigit() for x in parts) or not 224 <= int(parts[0]) <= 239:
-            p.append(f"publish.multicast_group: {cfg.publish.multicast_group!r} is not an IPv4 multicast address")
+    if cfg.publish.multicast_group and not ck.is_ipv4_multicast(cfg.publish.multicast_group):
+        p.append(f"publish.multicast_group: {cfg.publish.multicast_group!r} is not an IPv4 multicast address")
     return p
 
 

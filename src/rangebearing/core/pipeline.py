@@ -13,7 +13,6 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from ..errors import FrameError
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, find_pairs, refine
@@ -22,20 +21,7 @@ from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .tracking import Track, step
-from .types import CameraIntrinsics, FrameResult, Landmark
-
-
-def check_frame(frame: object) -> np.ndarray:
-    """Return ``frame`` if it is a non-empty H×W×3 uint8 array, else raise :class:`FrameError`."""
-    if not isinstance(frame, np.ndarray):
-        raise FrameError(f"frame is {type(frame).__name__}, not a numpy array")
-    if frame.ndim != 3 or frame.shape[2] != 3:
-        raise FrameError(f"frame has shape {frame.shape}, expected (height, width, 3) BGR")
-    if frame.dtype != np.uint8:
-        raise FrameError(f"frame has dtype {frame.dtype}, expected uint8")
-    if frame.shape[0] < 8 or frame.shape[1] < 8:
-        raise FrameError(f"frame of {frame.shape[1]}×{frame.shape[0]} pixels is too small")
-    return frame
+from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 
 
 class Pipeline:
@@ -71,14 +57,7 @@ class Pipeline:
         """Intrinsics for this frame size and the band-preserving filter size."""
         key = (w, h)
         if key not in self._cams:
-            cam = self.params.camera
-            if (cam.width_px, cam.height_px) != key:
-                if abs(w * cam.height_px - h * cam.width_px) > 0.01 * w * cam.height_px:
-                    raise FrameError(
-                        f"frame is {w}×{h} but the camera intrinsics are for {cam.width_px}×{cam.height_px}, "
-                        "another aspect ratio (a cropped sensor mode): configure camera.* for this resolution"
-                    )
-                cam = cam.scaled(w, h)  # the same sensor area at another resolution
+            cam = self.params.camera.for_frame(w, h)
             far = self.params.model.envelope_range_m[1]
             band_px = cam.fy_px * self.params.landmark.band_height_m / far / self.params.detection.downscale
             self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))

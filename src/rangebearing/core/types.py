@@ -10,7 +10,10 @@ from __future__ import annotations
 import math
 from typing import Optional, Tuple
 
+import numpy as np
+
 from .._compat import frozen
+from ..errors import FrameError
 
 XY = Tuple[float, float]
 BBox = Tuple[int, int, int, int]  # x, y, width, height in pixels
@@ -39,6 +42,23 @@ class CameraIntrinsics:
     @property
     def hfov_rad(self) -> float:
         return 2.0 * math.atan(self.width_px / (2.0 * self.fx_px))
+
+    def for_frame(self, width_px: int, height_px: int) -> CameraIntrinsics:
+        """These intrinsics for frames of ``width_px × height_px``.
+
+        The same size returns ``self``; another size of the same aspect ratio
+        (within 1 %) is the same sensor area at another resolution
+        (:meth:`scaled`). Raises FrameError for another aspect ratio (a cropped
+        sensor mode), whose intrinsics cannot be derived from these.
+        """
+        if (width_px, height_px) == (self.width_px, self.height_px):
+            return self
+        if abs(width_px * self.height_px - height_px * self.width_px) > 0.01 * width_px * self.height_px:
+            raise FrameError(
+                f"frame is {width_px}×{height_px} but the camera intrinsics are for {self.width_px}×{self.height_px}, "
+                "another aspect ratio (a cropped sensor mode): configure camera.* for this resolution"
+            )
+        return self.scaled(width_px, height_px)
 
     def scaled(self, width_px: int, height_px: int) -> CameraIntrinsics:
         """The same camera at another resolution (same field of view)."""
@@ -71,6 +91,29 @@ class LandmarkGeometry:
     def band_spacing_m(self) -> float:
         """Vertical distance between the red and blue band centres (55 mm by default)."""
         return self.height_m - self.band_height_m
+
+
+MIN_FRAME_SIDE_PX = 8
+
+
+def check_frame(frame: object, min_side_px: int = MIN_FRAME_SIDE_PX) -> np.ndarray:
+    """Return ``frame`` if it is an H×W×3 uint8 array of at least ``min_side_px`` a side, else raise FrameError.
+
+    The one frame check of the package: the pipeline calls it on every frame,
+    and the sources call it (with ``min_side_px=1``) after converting what a
+    decoder or camera produced.
+    """
+    if not isinstance(frame, np.ndarray):
+        raise FrameError(f"frame is {type(frame).__name__}, not a numpy array")
+    if frame.size == 0:
+        raise FrameError(f"empty image of shape {frame.shape}")
+    if frame.dtype != np.uint8:
+        raise FrameError(f"frame has dtype {frame.dtype}, expected uint8")
+    if frame.ndim != 3 or frame.shape[2] != 3:
+        raise FrameError(f"frame has shape {frame.shape}, expected (height, width, 3) BGR")
+    if frame.shape[0] < min_side_px or frame.shape[1] < min_side_px:
+        raise FrameError(f"frame of {frame.shape[1]}×{frame.shape[0]} pixels is too small")
+    return frame
 
 
 def union(a: BBox, b: BBox) -> BBox:

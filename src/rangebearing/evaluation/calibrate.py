@@ -35,7 +35,7 @@ def collect_samples(frames: Frames, cfg: Config) -> List[Sample]:
         if image is None or not rows:
             continue
         h, w = image.shape[:2]
-        cam = cfg.camera if (cfg.camera.width_px, cfg.camera.height_px) == (w, h) else cfg.camera.scaled(w, h)
+        cam = cfg.camera.for_frame(w, h)
         matches, _ = match_frame(name, pipe.process(image).landmarks, rows, CALIBRATION_GAP_RAD)
         for m in matches:
             if m.found is None:

@@ -16,7 +16,8 @@ import time
 from typing import Iterator, Optional, Tuple
 
 from ..config import DEFAULT_PORT
-from ..errors import ConfigError, ProtocolError
+from ..config.checks import is_ipv4_multicast
+from ..errors import ProtocolError, SubscribeError
 from .protocol import Reading, decode_reading
 
 _RECV_BYTES = 65536
@@ -26,8 +27,7 @@ def _ipv4(value: str, what: str) -> bytes:
     try:
         return socket.inet_aton(socket.gethostbyname(value))
     except (OSError, UnicodeError) as exc:
-        raise ConfigError([f"{what}: {value!r} is not an IPv4 address or host: {exc}"],
-                          "subscriber") from None
+        raise SubscribeError(f"{what}: {value!r} is not an IPv4 address or host: {exc}") from None
 
 
 class Subscriber:
@@ -70,9 +70,9 @@ class Subscriber:
             raise
 
     def _join(self, group: str, port: int, interface: str) -> None:
+        if not is_ipv4_multicast(group):
+            raise SubscribeError(f"group: {group!r} is not an IPv4 multicast address")
         mreq = _ipv4(group, "group") + _ipv4(interface, "interface")
-        if not 224 <= mreq[0] <= 239:
-            raise ConfigError([f"group: {group!r} is not an IPv4 multicast address"], "subscriber")
         # Several listeners on one host may share a group port.
         self._sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:

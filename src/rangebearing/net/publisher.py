@@ -16,7 +16,7 @@ from typing import Callable, Dict, List, Optional, Protocol, Tuple
 
 from .._compat import frozen
 from ..config import PublishConfig
-from ..errors import ConfigError
+from ..errors import PublishError
 
 _log = logging.getLogger(__name__)
 
@@ -72,7 +72,7 @@ def _resolve(host: str, port: int, key: str) -> Tuple[int, Tuple[str, int]]:
     try:
         infos = socket.getaddrinfo(host, port, 0, socket.SOCK_DGRAM)
     except (OSError, UnicodeError) as exc:
-        raise ConfigError([f"{key}: cannot resolve host {host!r}: {exc}"], "publish") from None
+        raise PublishError(f"{key}: cannot resolve host {host!r}: {exc}") from None
     infos.sort(key=lambda info: info[0] != socket.AF_INET)
     family, _, _, _, sockaddr = infos[0]
     return family, (str(sockaddr[0]), int(sockaddr[1]))
@@ -108,7 +108,7 @@ class UdpPublisher:
     """Sends each payload to every unicast destination and the multicast group.
 
     Host names are resolved once, here: a name that does not resolve is a
-    configuration problem and raises :class:`~rangebearing.errors.ConfigError`.
+    configuration problem and raises :class:`~rangebearing.errors.PublishError`.
     Multicast goes out of ``multicast_interface`` (``""`` lets the kernel pick)
     with ``multicast_ttl`` and loopback on, so a listener on the same robot hears it.
     """
@@ -152,10 +152,7 @@ class UdpPublisher:
             sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(iface))
         except OSError as exc:
             sock.close()
-            raise ConfigError(
-                [f"publish.multicast_interface: cannot send multicast from {iface!r}: {exc}"],
-                "publish",
-            ) from None
+            raise PublishError(f"publish.multicast_interface: cannot send multicast from {iface!r}: {exc}") from None
         self._add(_name(group, port), sock, addr)
 
     def send(self, payload: bytes) -> None:

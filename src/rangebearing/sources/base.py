@@ -15,6 +15,7 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
+from ..core.types import check_frame
 from ..errors import FrameError
 
 
@@ -85,21 +86,15 @@ def validate_frame(image: object) -> np.ndarray:
     """
     if image is None:
         raise FrameError("no image (the decoder or camera returned None)")
-    if not isinstance(image, np.ndarray):
-        raise FrameError(f"expected a numpy image, got {type(image).__name__}")
-    if image.size == 0:
-        raise FrameError(f"empty image of shape {image.shape}")
-    if image.dtype != np.uint8:
-        raise FrameError(f"expected uint8 pixels, got {image.dtype}")
-    if image.ndim == 3 and image.shape[2] == 1:
-        image = image[:, :, 0]
-    if image.ndim == 2:
-        return cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_GRAY2BGR)
-    if image.ndim != 3 or image.shape[2] not in (3, 4):
-        raise FrameError(f"expected H×W, H×W×3 or H×W×4 pixels, got shape {image.shape}")
-    if image.shape[2] == 4:
-        image = image[:, :, :3]
-    return np.ascontiguousarray(image)
+    if isinstance(image, np.ndarray) and image.dtype == np.uint8 and image.size:
+        if image.ndim == 3 and image.shape[2] == 1:
+            image = image[:, :, 0]
+        if image.ndim == 2:
+            image = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_GRAY2BGR)
+        elif image.ndim == 3 and image.shape[2] == 4:
+            image = image[:, :, :3]
+        image = np.ascontiguousarray(image)
+    return check_frame(image, min_side_px=1)
 
 
 Sleep = Callable[[float], object]

@@ -16,8 +16,9 @@ from typing import Callable, Optional, Union
 
 import cv2
 
-from ..errors import CameraError, FrameError, SourceError
+from ..errors import FrameError, SourceError
 from .base import Frame, validate_frame
+from .faults import TimeoutBudget
 
 _log = logging.getLogger(__name__)
 
@@ -53,7 +54,7 @@ class OpenCVSource:
         self._height = height
         self._fps = fps
         self._timeout_s = timeout_s
-        self._retries = max(1, retries)
+        self._budget = TimeoutBudget(str(device), timeout_s, retries)
         self._clock = clock
         self._live = not os.path.isfile(self._device)
         self._cond = threading.Condition()
@@ -63,7 +64,7 @@ class OpenCVSource:
         self._ended = False
         self._failure: Optional[SourceError] = None
         self._dropped = 0
-        self._timeouts = 0
+        self._budget.frame_arrived()
 
     @property
     def dropped(self) -> int:
@@ -146,7 +147,7 @@ class OpenCVSource:
             self._cond.notify_all()
             ended, failure = self._ended, self._failure
         if item is not None:
-            self._timeouts = 0
+            self._budget.frame_arrived()
             if isinstance(item, FrameError):
                 raise item
             return item
@@ -154,11 +155,7 @@ class OpenCVSource:
             raise failure
         if ended or ready:
             return None
-        self._timeouts += 1
-        msg = f"{self._device}: no frame within {self._timeout_s:g} s"
-        if self._timeouts >= self._retries:
-            raise CameraError(f"{msg} ({self._timeouts} times in a row); giving up")
-        raise FrameError(f"{msg} (timeout {self._timeouts} of {self._retries})")
+        raise self._budget.timed_out()
 
     def close(self) -> None:
         """Stop the grabber; waits briefly for it, never forever (a network read can block)."""

@@ -31,6 +31,7 @@ import numpy as np
 from ..config import SourceConfig
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
+from .faults import TimeoutBudget
 
 _log = logging.getLogger(__name__)
 
@@ -128,7 +129,7 @@ class Picamera2Source:
         self._prev_sensor_ns: Optional[int] = None
         self._next_index = 0
         self._dropped = 0
-        self._timeouts = 0
+        self._budget = TimeoutBudget(f"camera {cfg.camera_num}", cfg.timeout_s, cfg.retries)
 
     @property
     def dropped(self) -> int:
@@ -163,7 +164,7 @@ class Picamera2Source:
         self._prev_sensor_ns = None
         self._next_index = 0
         self._dropped = 0
-        self._timeouts = 0
+        self._budget.frame_arrived()
 
     def _acquire(self, picamera2_cls: Any) -> Any:
         n = self._cfg.camera_num
@@ -210,21 +211,16 @@ class Picamera2Source:
             raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
         finally:
             request.release()
-        self._timeouts = 0
+        self._budget.frame_arrived()
         if isinstance(array, np.ndarray) and array.ndim == 3:
             array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
         image = validate_frame(array)
         return self._stamp(image, metadata, received_ns)
 
-    def _timed_out(self, cam: Any) -> FrameError:
+    def _timed_out(self, cam: Any) -> Exception:
         # The timed-out job is still queued: flush it before it swallows a frame.
         cam.cancel_all_and_flush()
-        self._timeouts += 1
-        limit = max(1, self._cfg.retries)
-        msg = f"camera {self._cfg.camera_num}: no frame within {self._cfg.timeout_s:g} s"
-        if self._timeouts >= limit:
-            return CameraError(f"{msg} ({self._timeouts} times in a row); giving up")
-        return FrameError(f"{msg} (timeout {self._timeouts} of {limit})")
+        return self._budget.timed_out()
 
     def _stamp(self, image: np.ndarray, metadata: Dict[str, Any], received_ns: int) -> Frame:
         sensor_ns = metadata.get("SensorTimestamp")

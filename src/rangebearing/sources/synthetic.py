@@ -16,7 +16,7 @@ import numpy as np
 
 from ..config import SourceConfig
 from ..core.types import CameraIntrinsics
-from ..errors import SourceError
+from ..errors import FrameError, SourceError
 from ..synth.render import render
 from ..synth.scene import LandmarkPose, Scene
 from .base import Frame
@@ -54,8 +54,10 @@ class SyntheticSource:
         clock: Callable[[], int] = time.monotonic_ns,
         sleep: Callable[[float], object] = time.sleep,
     ) -> None:
-        if (camera.width_px, camera.height_px) != (cfg.width_px, cfg.height_px):
-            camera = camera.scaled(cfg.width_px, cfg.height_px)
+        try:
+            camera = camera.for_frame(cfg.width_px, cfg.height_px)
+        except FrameError as exc:
+            raise SourceError(f"synthetic source: {exc}") from None
         self._scene = dataclasses.replace(scene or Scene(), camera=camera)
         self._path = path
         self._fps = cfg.fps if cfg.fps > 0 else 30.0

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from ..errors import ConfigError
+from ..errors import SceneError
 from .scene import LandmarkPose, Scene
 
 Rect = Tuple[int, int, int, int]  # row0, row1, col0, col1 (half-open)
@@ -42,7 +42,7 @@ class RayGrid(NamedTuple):
 def _coefficients(camera: CameraIntrinsics) -> np.ndarray:
     d = tuple(camera.distortion)
     if len(d) not in (0, 4, 5, 8):
-        raise ConfigError(
+        raise SceneError(
             [f"camera.distortion: {len(d)} coefficients; the renderer supports 4, 5 or 8"], "synthetic camera"
         )
     return np.array(d + (0.0,) * (8 - len(d)), dtype=np.float64)

@@ -18,7 +18,7 @@ import numpy as np
 import yaml
 
 from ..core.types import CameraIntrinsics
-from ..errors import ConfigError
+from ..errors import SceneError
 from ..evaluation.truth import TruthRow, write_truth
 from .camera import inside_image, landmark_bbox_px
 from .presets import PRESETS, scene_sequence
@@ -62,7 +62,7 @@ def _check(frames: int, seed: int, preset: str, fmt: str, jpeg_quality: int) -> 
     if not 1 <= jpeg_quality <= 100:
         problems.append(f"jpeg_quality must be 1-100, got {jpeg_quality!r}")
     if problems:
-        raise ConfigError(problems, "synth")
+        raise SceneError(problems, "synth")
 
 
 def _encode(image: np.ndarray, fmt: str, jpeg_quality: int) -> bytes:
@@ -116,7 +116,7 @@ def write_dataset(out_dir: Union[str, os.PathLike], frames: int, seed: int,
     FileExistsError
         ``out_dir`` already holds frames or a truth file and ``overwrite`` is
         false (stale frames would pass for frames without a landmark).
-    ConfigError
+    SceneError
         A bad argument (frames, seed, preset, format, quality).
     """
     _check(frames, seed, preset, fmt, jpeg_quality)

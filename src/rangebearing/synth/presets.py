@@ -21,7 +21,7 @@ import numpy as np
 
 from .._compat import frozen
 from ..core.types import CameraIntrinsics
-from ..errors import ConfigError
+from ..errors import SceneError
 from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
@@ -146,7 +146,7 @@ def random_scene(rng: np.random.Generator, preset: str,
 
     Raises
     ------
-    ConfigError
+    SceneError
         Unknown preset, or a camera too small to place the landmarks in.
     """
     if preset == "paper":
@@ -160,7 +160,7 @@ def random_scene(rng: np.random.Generator, preset: str,
     if preset == "sample":
         base, paths = sample_plan(rng, camera)
         return sample_scene(base, paths, d.uniform(rng, 0.0, 60.0))
-    raise ConfigError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
+    raise SceneError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
 
 
 def scene_sequence(rng: np.random.Generator, preset: str, frames: int,

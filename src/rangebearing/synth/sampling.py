@@ -9,7 +9,7 @@ from typing import Callable, Dict, Optional, Tuple
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from ..errors import ConfigError
+from ..errors import SceneError
 from .camera import inside_image, landmark_bbox_px
 from .scene import DEFAULT_BASE_HEIGHT_M, RGB, Imaging, LandmarkPose, Lighting, Scene
 
@@ -121,8 +121,8 @@ def draw_landmark(rng: np.random.Generator, scene: Scene,
     return None
 
 
-def give_up(preset: str, camera: CameraIntrinsics) -> ConfigError:
-    return ConfigError([f"preset {preset!r}: cannot place landmarks wholly in view of a "
+def give_up(preset: str, camera: CameraIntrinsics) -> SceneError:
+    return SceneError([f"preset {preset!r}: cannot place landmarks wholly in view of a "
                         f"{camera.width_px}x{camera.height_px} camera"], "synth")
 
 

@@ -13,7 +13,7 @@ from typing import Optional, Tuple
 
 from .._compat import frozen
 from ..core.types import CameraIntrinsics, LandmarkGeometry
-from ..errors import ConfigError
+from ..errors import SceneError
 
 RGB = Tuple[float, float, float]
 
@@ -164,4 +164,4 @@ class Scene:
                 if not obj.top_m > obj.bottom_m:
                     problems.append(f"{name}[{i}]: top_m must be above bottom_m")
         if problems:
-            raise ConfigError(problems, "synthetic scene")
+            raise SceneError(problems, "synthetic scene")

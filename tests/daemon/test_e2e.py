@@ -95,11 +95,13 @@ def test_daemon_end_to_end(static_clip, tmp_path):
 
             cfg.write_text(config_text(static_clip, "beta", uni.port, multi.port))
             proc.send_signal(signal.SIGHUP)
+            wait_notify(notify, "RELOADING=1", timeout_s=5)
             check_truth(wait_reading(uni, "beta"))  # the new config took effect without a restart
 
             cfg.write_text("publish: {unicast: [nonsense]}\ndetection: {median_ksize: 4}\n")
             proc.send_signal(signal.SIGHUP)
-            time.sleep(0.5)
+            wait_notify(notify, "RELOADING=1", timeout_s=5)
+            wait_notify(notify, "READY=1", timeout_s=5)  # the reload is over: rejected
             assert proc.poll() is None  # a bad config on SIGHUP is rejected, not fatal
             assert wait_reading(uni, "beta").seq > first.seq
 

@@ -119,10 +119,13 @@ def test_a_missing_udp_receiver_never_stops_the_daemon(static_clip):
 def test_stop_from_another_thread_ends_a_paced_source_promptly(static_clip):
     cfg = recorded_cfg(static_clip, loop=True)
     cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, fps=2.0))  # long waits between frames
-    daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    two_sent = threading.Event()
+    sent: List[bytes] = []
+    daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier(),
+                    echo=lambda p: (sent.append(p), len(sent) >= 2 and two_sent.set()))
     t = threading.Thread(target=daemon.run)
     t.start()
-    time.sleep(0.3)
+    assert two_sent.wait(5)  # the loop is now inside a 0.5 s wait for the next frame
     t0 = time.monotonic()
     daemon.stop()
     t.join(5)
@@ -188,7 +191,7 @@ def test_reloads_swap_the_publisher_and_survive_a_source_that_will_not_open(stat
 
     from rangebearing.config import load_config
 
-    daemon = Daemon(load_config(cfg_file), opener, open_pub, RecordingNotifier(), config_path=str(cfg_file))
+    daemon = Daemon(load_config(cfg_file), opener, open_pub, RecordingNotifier(), reload=lambda: load_config(cfg_file))
     robots: List[str] = []
 
     def echo(payload: bytes) -> None:

@@ -7,7 +7,7 @@ import pytest
 from rangebearing.config import Config, config_from_mapping, dump_config, load_config
 from rangebearing.errors import ConfigError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_defaults_without_a_file():
