@@ -13,7 +13,7 @@ from rangebearing.cli.main import main
 from rangebearing.config import load_config
 from rangebearing.core.types import CameraIntrinsics
 from rangebearing.errors import SceneError
-from rangebearing.evaluation.truth import read_truth
+from rangebearing.evaluation.truth import TruthRow, read_truth, write_truth
 from rangebearing.synth import LandmarkPose, Scene, generate, scene_truth, write_dataset
 
 
@@ -82,10 +82,30 @@ def test_bad_arguments(tmp_path, kwargs, word):
     assert not list(tmp_path.iterdir())
 
 
-def test_scene_truth_keeps_only_landmarks_wholly_in_view():
+def test_scene_truth_lists_every_landmark_in_view_with_its_visible_fraction():
+    # wholly in view; cut by the left frame edge (bearing 0.47 rad ~ 26.9 deg); behind the camera
     scene = Scene(landmarks=(LandmarkPose(0.5, 0.1), LandmarkPose(0.5, 0.47), LandmarkPose(0.5, 3.0)))
     rows = scene_truth(scene, "000001.png")
-    assert [(r.frame, r.range_m, r.bearing_rad) for r in rows] == [("000001.png", 0.5, 0.1)]
+    assert [(r.frame, r.range_m, r.bearing_rad) for r in rows] == [("000001.png", 0.5, 0.1),
+                                                                   ("000001.png", 0.5, 0.47)]
+    whole, cut = rows
+    assert (whole.visible, whole.red_visible, whole.blue_visible, whole.findable) == (1.0, 1.0, 1.0, True)
+    assert 0.0 < cut.visible < 0.6 and not cut.findable
+    assert cut.red_visible == pytest.approx(cut.blue_visible, abs=0.02)
+    assert whole.robot is None
+
+
+def test_truth_csv_round_trips_the_optional_columns(tmp_path):
+    rows = [TruthRow("a.png", 0.5, 0.1, 0.5, 0.25, 0.75, False, 3), TruthRow("b.png", 1.0, -0.2)]
+    write_truth(tmp_path / "t.csv", rows)
+    header = (tmp_path / "t.csv").read_text().splitlines()[0]
+    assert header == "frame,range_m,bearing_rad,visible,red_visible,blue_visible,findable,robot"
+    back = read_truth(tmp_path / "t.csv")
+    assert back["a.png"] == [rows[0]] and back["b.png"] == [rows[1]]
+    # a plain three-column file still reads, optional fields unknown
+    write_truth(tmp_path / "plain.csv", [TruthRow("c.png", 0.3, 0.0)])
+    assert (tmp_path / "plain.csv").read_text().splitlines()[0] == "frame,range_m,bearing_rad"
+    assert read_truth(tmp_path / "plain.csv")["c.png"][0].findable is None
 
 
 # --- the command ---------------------------------------------------------------

@@ -32,7 +32,7 @@ def draws(preset: str, n: int, seed: int = 11, camera: CameraIntrinsics = CAM) -
     return [random_scene(rng, preset, camera) for _ in range(n)]
 
 
-@pytest.mark.parametrize("preset", PRESETS)
+@pytest.mark.parametrize("preset", ("paper", "wide", "clutter", "multi", "sample", "far"))
 def test_every_landmark_is_wholly_in_view_with_a_margin(preset):
     for scene in draws(preset, 60):
         for lm in scene.landmarks:

@@ -10,7 +10,7 @@ from typing import Any, Tuple
 from ..core.types import CameraIntrinsics
 from ..errors import OutputError
 from ..synth.dataset import CAMERA_FILE, FORMATS, TRUTH_FILE, write_dataset
-from ..synth.presets import PRESETS
+from ..synth.presets import PRESET_HELP, PRESETS
 
 
 def _size(text: str) -> Tuple[int, int]:
@@ -49,12 +49,12 @@ def register(subparsers: Any) -> None:
         "synth",
         help="render synthetic frames with exact ground truth",
         description="Ray-trace camera frames of landmarks (and distractors) with known range and "
-        "bearing. Writes 000000.png ... into DIR, truth.csv (frame,range_m,bearing_rad; one row "
-        "per landmark, none for an empty frame) and camera.yaml (the intrinsics, usable as "
-        "--config). Presets: paper = one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg; "
-        "wide = 0.15-2 m anywhere in view, tinted rooms, dim/bright/warm/cool light; "
-        "clutter = red/blue distractors, half the frames without a landmark; "
-        "multi = 2-4 landmarks; sample = two neighbours moving smoothly at 30 fps.",
+        "bearing. Writes 000000.png ... into DIR, truth.csv (frame,range_m,bearing_rad, then "
+        "visible,red_visible,blue_visible: the fraction of the landmark and of each band in "
+        "view, findable: 1 when both bands are >= 60 % visible, robot: an identity kept over a "
+        "sequence; one row per landmark in view, none for an empty frame) and camera.yaml (the "
+        "intrinsics, usable as --config). Presets: "
+        + "; ".join(f"{k} = {v}" for k, v in PRESET_HELP.items()) + ".",
     )
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
     p.add_argument("--frames", required=True, type=_count, metavar="N", help="number of frames")
@@ -104,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
     with_landmark = len({row.frame for row in truth})
     print(
         f"synth: {args.frames} {args.preset} frames ({camera.width_px}x{camera.height_px} "
-        f"{args.fmt}, seed {args.seed}) in {args.out}: {len(truth)} landmarks, "
+        f"{args.fmt}, seed {args.seed}) in {args.out}: {len(truth)} landmarks "
+        f"({sum(row.findable is not False for row in truth)} findable), "
         f"{args.frames - with_landmark} frames without one; {TRUTH_FILE}, {CAMERA_FILE}; "
         f"{seconds:.1f} s"
     )

@@ -20,10 +20,10 @@ import yaml
 from ..core.types import CameraIntrinsics
 from ..errors import SceneError
 from ..evaluation.truth import TruthRow, write_truth
-from .camera import inside_image, landmark_bbox_px
 from .presets import PRESETS, scene_sequence
 from .render import render
 from .scene import DEFAULT_CAMERA, Scene
+from .visibility import landmark_visibility
 
 FORMATS = ("png", "jpg")
 TRUTH_FILE = "truth.csv"
@@ -37,12 +37,19 @@ def frame_name(index: int, fmt: str = "png") -> str:
 
 
 def scene_truth(scene: Scene, frame: str) -> List[TruthRow]:
-    """Truth rows for a scene: its landmarks wholly inside the frame, exact, in scene order.
+    """Truth rows for a scene: every landmark the frame shows any part of, in scene order.
 
-    Occlusion is not checked; every preset keeps landmarks unoccluded.
+    Range and bearing are exact; ``visible``, ``red_visible``, ``blue_visible``
+    and ``findable`` come from :func:`.visibility.landmark_visibility` (hidden
+    behind nearer things or cut off by the frame edge both count as not
+    visible); ``robot`` is the landmark's ``robot_id`` when it has one.
     """
-    return [TruthRow(frame, lm.range_m, lm.bearing_rad) for lm in scene.landmarks
-            if inside_image(scene.camera, landmark_bbox_px(scene, lm))]
+    rows = []
+    for lm, vis in zip(scene.landmarks, landmark_visibility(scene)):
+        if vis.overall > 0.0:
+            rows.append(TruthRow(frame, lm.range_m, lm.bearing_rad, vis.overall, vis.red, vis.blue,
+                                 vis.findable, lm.robot_id if lm.robot_id >= 0 else None))
+    return rows
 
 
 def _whole(v: object) -> bool:

@@ -6,8 +6,17 @@
 ``multi``    2–4 landmarks, 0.2–1.5 m, image extents apart (none occludes another).
 ``sample``   two neighbours moving smoothly, as in a short recorded clip (30 fps).
 
-Every landmark a preset draws lies wholly inside the frame, so the truth of a
-frame is its scene's landmarks.
+These five draw landmarks wholly inside the frame, unhidden, on plain dark
+cylinders, under plain light, and render exactly as they always have for the
+same seed. The crowd-proof presets put Zumo-like robots under the landmarks,
+let them hide each other (the truth gives each band's visible fraction) and run
+an auto-exposed Bayer camera:
+
+``occlusion``  2–4 robots, one right behind another, a box in front now and then.
+``touching``   landmarks against each other and against red and blue walls,
+               boxes, mats, posters and objects; one frame in eight empty.
+``crowd``      5–8 robots, some cut by the frame edges.
+``far``        one robot 0.15–2.0 m anywhere wholly in view, any light.
 """
 
 from __future__ import annotations
@@ -25,10 +34,24 @@ from ..errors import SceneError
 from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
+from .crowd import crowd_scene, far_scene, occlusion_scene
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
+from .touching import touching_scene
 
-PRESETS = ("paper", "wide", "clutter", "multi", "sample")
+PRESETS = ("paper", "wide", "clutter", "multi", "sample", "occlusion", "touching", "crowd", "far")
 SAMPLE_FPS = 30.0
+PRESET_HELP = {
+    "paper": "one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg",
+    "wide": "0.15-2 m anywhere in view, tinted rooms, dim/bright/warm/cool light",
+    "clutter": "red/blue distractors, half the frames without a landmark",
+    "multi": "2-4 landmarks, apart in the image",
+    "sample": "two neighbours moving smoothly at 30 fps",
+    "occlusion": "2-4 Zumo-like robots, some landmarks partly behind others or a box",
+    "touching": "landmarks touching each other and red/blue walls, boxes, mats, posters; "
+                "1 frame in 8 empty",
+    "crowd": "5-8 robots in view, some cut by the frame edges",
+    "far": "one robot 0.15-2.0 m over the whole field of view, any light",
+}
 
 
 def _paper(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
@@ -131,6 +154,10 @@ def sample_scene(base: Scene, paths: Tuple[Wander, ...], t_s: float) -> Scene:
     return dataclasses.replace(base, landmarks=visible)
 
 
+_NEWER = {"occlusion": occlusion_scene, "touching": touching_scene, "crowd": crowd_scene,
+          "far": far_scene}
+
+
 def random_scene(rng: np.random.Generator, preset: str,
                  camera: CameraIntrinsics = DEFAULT_CAMERA) -> Scene:
     """Draw one scene of a preset (see the module docstring).
@@ -160,6 +187,8 @@ def random_scene(rng: np.random.Generator, preset: str,
     if preset == "sample":
         base, paths = sample_plan(rng, camera)
         return sample_scene(base, paths, d.uniform(rng, 0.0, 60.0))
+    if preset in _NEWER:
+        return _NEWER[preset](rng, camera)
     raise SceneError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
 
 

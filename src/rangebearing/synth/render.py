@@ -12,7 +12,8 @@ Two passes of per-pixel ray casting (vectorised numpy):
    spacing L within 0.05 %.
 
 Then the sensor: optical blur, exposure and white balance, shot and read
-noise, clipping, gamma, 8-bit quantisation.
+noise, clipping, gamma, 8-bit quantisation (or, for the newer presets, the
+auto-exposed Bayer camera of :mod:`.sensor`).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import numpy as np
 
 from .camera import Rect, pixel_rect, ray_grid
 from .scene import Scene
+from .sensor import develop_sensor
 from .trace import Cyl, Primitive, Shader, primitives, trace, trace_background
 
 SMALL_LANDMARK_PX = 2500  # image extents up to this many pixels are supersampled whole
@@ -153,9 +155,12 @@ def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator]
 
     Blur (optical, linear light) → exposure × white-balance gains → shot and
     read noise (only with an ``rng``) → clip to [0, 1] → gamma → 8 bits.
+    With auto exposure, a Bayer mosaic or glare, :func:`.sensor.develop_sensor`.
     """
-    img = linear.astype(np.float32)
     im, li = scene.imaging, scene.lighting
+    if im.auto_exposure or im.bayer or im.glare > 0:
+        return develop_sensor(linear, scene, rng, _gamma_lut(float(im.gamma)))
+    img = linear.astype(np.float32)
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
     img *= np.float32(li.exposure) * np.asarray(li.wb_gains, dtype=np.float32)

@@ -31,15 +31,53 @@ DEFAULT_CAMERA = CameraIntrinsics()
 
 
 @frozen
+class RobotBody:
+    """A Zumo-like robot under a landmark: tracked chassis, boards, a mast.
+
+    Heights are from the floor; lengths along the robot's heading. The mast is
+    a dark standoff from the top board up to the landmark's base (none when the
+    base is no higher than the board); ``mast_colour`` may be slightly bluish
+    or reddish, as a 3D-printed or anodised part would be.
+    """
+
+    length_m: float = 0.098
+    width_m: float = 0.090
+    track_width_m: float = 0.016
+    track_height_m: float = 0.036
+    chassis_top_m: float = 0.034
+    board_top_m: float = 0.050
+    board_width_m: float = 0.056
+    board_length_m: float = 0.085
+    mast_radius_m: float = 0.012
+    chassis_colour: RGB = (0.035, 0.035, 0.038)
+    track_colour: RGB = (0.025, 0.025, 0.025)
+    board_colour: RGB = (0.05, 0.16, 0.07)
+    blade_colour: RGB = (0.50, 0.50, 0.52)
+    mast_colour: RGB = (0.04, 0.04, 0.045)
+
+    @property
+    def footprint_m(self) -> float:
+        """Radius of the circle around the robot's footprint (blade included)."""
+        return math.hypot(self.length_m / 2 + 0.01, self.width_m / 2)
+
+
+@frozen
 class LandmarkPose:
     """One neighbour: its landmark's axis position and the height of its base.
 
-    The robot under it is a dark cylinder from the floor up to ``base_height_m``.
+    With ``body=None`` the robot under it is a dark cylinder from the floor up
+    to ``base_height_m`` (the original presets); with a :class:`RobotBody` it is
+    a Zumo-like robot turned to ``heading_rad`` (0 = facing the camera's +X,
+    counter-clockwise seen from above). ``robot_id`` names the robot across the
+    frames of a sequence (-1: not tracked).
     """
 
     range_m: float
     bearing_rad: float
     base_height_m: float = DEFAULT_BASE_HEIGHT_M
+    heading_rad: float = 0.0
+    body: Optional[RobotBody] = None
+    robot_id: int = -1
 
     @property
     def x_m(self) -> float:
@@ -50,6 +88,24 @@ class LandmarkPose:
     def z_m(self) -> float:
         """World Z of the axis: the depth along the optical axis (the paper's d_v)."""
         return self.range_m * math.cos(self.bearing_rad)
+
+
+@frozen
+class Spot:
+    """A point light (a lamp, a spotlight) at ``position`` aimed at ``target``.
+
+    Irradiance at a surface is ``intensity · colour · max(0, n·l) / d²`` inside
+    the cone, fading to nothing between ``cone_deg`` and ``cone_deg + soft_deg``
+    off its axis; ``intensity`` 0.25 at 0.5 m adds as much as a full directional
+    light. A large ``cone_deg`` makes a bare bulb.
+    """
+
+    position: Tuple[float, float, float]
+    target: Tuple[float, float, float]
+    intensity: float = 0.25
+    colour: RGB = (1.0, 1.0, 1.0)
+    cone_deg: float = 20.0
+    soft_deg: float = 4.0
 
 
 @frozen
@@ -90,13 +146,15 @@ class FloorPatch:
 
 @frozen
 class Poster:
-    """A rectangle of another colour on the back wall."""
+    """A rectangle of another colour on the back wall; with ``emission`` > 0 it
+    glows (a bright window: radiance ``colour · emission``, unshaded)."""
 
     x_min_m: float
     x_max_m: float
     bottom_m: float
     top_m: float
     colour: RGB
+    emission: float = 0.0
 
 
 @frozen
@@ -104,23 +162,53 @@ class Lighting:
     """A directional light plus ambient, and the camera's exposure and white balance.
 
     ``direction`` points from the scene towards the light (world frame, need
-    not be unit length). Radiance = albedo · (ambient + (1 − ambient)·max(0, n·l)).
+    not be unit length). Radiance = albedo · (ambient·ambient_colour +
+    (1 − ambient)·max(0, n·l)·colour) plus each spot's share, plus, on the
+    landmark's semi-gloss paint, a Blinn-Phong highlight ``gloss · (n·h)^shininess``
+    of every light's colour (a spotlight's can clip the band to white).
+    ``exposure`` is ignored when the camera runs auto exposure.
     """
 
     direction: Tuple[float, float, float] = (-0.35, 0.75, -0.55)
     ambient: float = 0.40
     exposure: float = 1.25
     wb_gains: RGB = (1.0, 1.0, 1.0)
+    colour: RGB = (1.0, 1.0, 1.0)
+    ambient_colour: RGB = (1.0, 1.0, 1.0)
+    spots: Tuple[Spot, ...] = ()
+    gloss: float = 0.0
+    shininess: float = 60.0
+
+    @property
+    def plain(self) -> bool:
+        """White light, no spots, no highlights: the original shading."""
+        return (self.colour == (1.0, 1.0, 1.0) and self.ambient_colour == (1.0, 1.0, 1.0)
+                and not self.spots and self.gloss == 0.0)
 
 
 @frozen
 class Imaging:
-    """The sensor and lens: blur, noise (in linear units of full scale) and gamma."""
+    """The sensor and lens: blur, noise (in linear units of full scale) and gamma.
+
+    ``auto_exposure``: the exposure is set from the scene's metered brightness
+    (centre-weighted mean luminance brought to ``ae_target``, times
+    ``ae_error`` for a loop not quite settled, within ``ae_limits``), and noise
+    grows with the gain it needs. ``bayer``: noise is drawn per photosite of an
+    RGGB mosaic that is then demosaiced (colour fringes at band edges).
+    ``glare``: the fraction of light scattered into a wide halo (veiling glare
+    from a bright window).
+    """
 
     blur_sigma_px: float = 0.0
     read_noise: float = 0.0
     shot_noise: float = 0.0
     gamma: float = 1.0 / 2.2
+    auto_exposure: bool = False
+    ae_target: float = 0.18
+    ae_error: float = 1.0
+    ae_limits: Tuple[float, float] = (0.3, 16.0)
+    bayer: bool = False
+    glare: float = 0.0
 
 
 @frozen

@@ -3,153 +3,104 @@
 Rays start at the camera centre ``(0, h, 0)`` with direction ``(dx, dy, 1)``
 (world frame, Y up), so the ray parameter ``t`` of a hit IS its depth Z and
 one buffer of ``t`` serves as the depth test. Every surface writes the linear
-radiance it reflects, ``albedo · (ambient + (1 − ambient)·max(0, n·l))``, and an
-integer id that changes wherever colour or normal jumps (the renderer
-supersamples pixels next to an id change).
+radiance it reflects (see :mod:`.lights`) and an integer id that changes
+wherever colour or normal jumps (the renderer supersamples pixels next to an
+id change).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import List, Tuple, Union
-
 import numpy as np
 
-from .scene import BLUE_PAINT, CAP_GREY, RED_PAINT, ROBOT_BODY, ROBOT_TOP, WHITE_PAINT, Scene
+from .lights import Shader
+from .parts import build, primitives
+from .scene import Scene
+from .shapes import (
+    ID_BACKGROUND,
+    ID_FLOOR,
+    ID_OBJECT,
+    ID_PATCH,
+    ID_POSTER,
+    ID_WALL,
+    PARTS,
+    Cuboid,
+    Cyl,
+    Hits,
+    OBox,
+    Primitive,
+)
 
-ID_BACKGROUND, ID_WALL, ID_FLOOR = 0, 1, 2
-ID_PATCH, ID_POSTER, ID_OBJECT = 16, 256, 1024
-PARTS = 16  # ids per object
+__all__ = ["ID_BACKGROUND", "ID_FLOOR", "ID_OBJECT", "ID_PATCH", "ID_POSTER", "ID_WALL", "PARTS",
+           "Cuboid", "Cyl", "Hits", "OBox", "Primitive", "Shader", "build", "primitives", "trace",
+           "trace_background"]
 
-
-@dataclass
-class Hits:
-    """Nearest hit found so far, per ray: depth, id and linear RGB radiance."""
-
-    t: np.ndarray
-    ident: np.ndarray
-    rad: np.ndarray
-
-    def view(self, index: Union[Tuple[slice, ...], np.ndarray]) -> Hits:
-        return Hits(self.t[index], self.ident[index], self.rad[index])
-
-    def put(self, index: Union[Tuple[slice, ...], np.ndarray], part: Hits) -> None:
-        self.t[index], self.ident[index], self.rad[index] = part.t, part.ident, part.rad
-
-
-@dataclass(frozen=True)
-class Shader:
-    """Lambertian shading with a unit direction towards the light and an ambient floor."""
-
-    light: np.ndarray
-    ambient: float
-
-    @classmethod
-    def from_scene(cls, scene: Scene) -> Shader:
-        d = np.asarray(scene.lighting.direction, dtype=np.float64)
-        return cls(d / np.linalg.norm(d), float(scene.lighting.ambient))
-
-    def __call__(self, albedo: np.ndarray, cos: np.ndarray) -> np.ndarray:
-        k = self.ambient + (1.0 - self.ambient) * np.maximum(cos, 0.0)
-        return np.asarray(albedo) * k[..., None]
+_BOX_NORMALS = np.array([[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1]], float)
 
 
-@dataclass(frozen=True)
-class Cyl:
-    """A vertical cylinder made of coloured segments; ``bounds[i]`` is segment i's bottom."""
-
-    x: float
-    z: float
-    r: float
-    y0: float
-    y1: float
-    bounds: np.ndarray
-    colours: np.ndarray  # (segments, 3)
-    cap: np.ndarray  # colour of the flat ends
-    ident: int
-
-    def extent(self) -> Tuple[float, float, float, float, float, float]:
-        return self.x - self.r, self.x + self.r, self.y0, self.y1, self.z - self.r, self.z + self.r
-
-
-@dataclass(frozen=True)
-class Cuboid:
-    """An axis-aligned box."""
-
-    x0: float
-    x1: float
-    y0: float
-    y1: float
-    z0: float
-    z1: float
-    colour: np.ndarray
-    ident: int
-
-    def extent(self) -> Tuple[float, float, float, float, float, float]:
-        return self.x0, self.x1, self.y0, self.y1, self.z0, self.z1
-
-
-Primitive = Union[Cyl, Cuboid]
-
-
-def primitives(scene: Scene) -> List[Primitive]:
-    """The scene's objects as primitives, each with its own block of ids."""
-    out: List[Primitive] = []
-    g = scene.geometry
-
-    def ident() -> int:
-        return ID_OBJECT + PARTS * len(out)
-
-    for lm in scene.landmarks:
-        b = lm.base_height_m
-        out.append(Cyl(lm.x_m, lm.z_m, scene.robot_radius_m, 0.0, b, np.array([0.0]),
-                       np.array([ROBOT_BODY]), np.array(ROBOT_TOP), ident()))
-        bounds = np.array([b, b + g.band_height_m, b + g.height_m - g.band_height_m])
-        colours = np.array([BLUE_PAINT, WHITE_PAINT, RED_PAINT])
-        out.append(Cyl(lm.x_m, lm.z_m, g.radius_m, b, b + g.height_m, bounds, colours,
-                       np.array(CAP_GREY), ident()))
-    for c in scene.cylinders:
-        out.append(Cyl(c.x_m, c.z_m, c.radius_m, c.bottom_m, c.top_m, np.array([c.bottom_m]),
-                       np.array([c.colour]), np.array(c.colour), ident()))
-    for bx in scene.boxes:
-        out.append(Cuboid(bx.x_m - bx.width_m / 2, bx.x_m + bx.width_m / 2, bx.bottom_m, bx.top_m,
-                          bx.z_m - bx.depth_m / 2, bx.z_m + bx.depth_m / 2, np.array(bx.colour),
-                          ident()))
-    return out
+def _points(dx: np.ndarray, dy: np.ndarray, h: float, t: np.ndarray) -> np.ndarray:
+    return np.stack([dx * t, h + dy * t, t], axis=-1)
 
 
 def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader) -> Hits:
     """Fresh hit buffers holding the floor (Y = 0, with patches), the back wall
     (Z = const, with posters) and, where neither is hit, the background colour.
 
-    Dense (no masked gathers): floor and wall radiance are constant per colour,
-    so every surface is one palette entry.
+    Dense (no masked gathers): under plain light floor and wall radiance are
+    constant per colour, so every surface is one palette entry; under rich
+    light the palette holds albedos, shaded per pixel.
     """
     h, zw = scene.camera_height_m, scene.wall_distance_m
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.where(dy < 0, h / -dy, np.inf)
+    rich = not shade.plain and len(shade.spot_pos) > 0  # shaded per pixel
+    normals = {"floor": np.array([0.0, 1.0, 0.0]), "wall": np.array([0.0, 0.0, -1.0])}
+
+    def lit(colour: object, surface: str) -> np.ndarray:
+        """A surface's radiance (its albedo when shaded per pixel later)."""
+        if rich:
+            return np.asarray(colour, float)
+        if shade.plain:
+            return shade(np.asarray(colour), np.asarray(normals[surface] @ shade.light))
+        return shade.rich(np.asarray(colour, float)[None], normals[surface][None], np.zeros((1, 3)))[0]
+
     palette = np.zeros((ID_POSTER + len(scene.posters), 3))
     palette[ID_BACKGROUND] = scene.background_colour
-    palette[ID_FLOOR] = shade(np.asarray(scene.floor_colour), np.asarray(shade.light[1]))
+    palette[ID_FLOOR] = lit(scene.floor_colour, "floor")
     ident = np.where(np.isfinite(t), ID_FLOOR, ID_BACKGROUND).astype(np.int32)
     if scene.floor_patches:
         x = dx * t
         for i, p in enumerate(scene.floor_patches):
-            palette[ID_PATCH + i] = shade(np.asarray(p.colour), np.asarray(shade.light[1]))
+            palette[ID_PATCH + i] = lit(p.colour, "floor")
             m = (x >= p.x_min_m) & (x <= p.x_max_m) & (t >= p.z_min_m) & (t <= p.z_max_m)
             ident[m] = ID_PATCH + i
+    glow = []
     if zw is not None:
         wall = zw < t
         t = np.where(wall, zw, t)
         ident[wall] = ID_WALL
-        palette[ID_WALL] = shade(np.asarray(scene.wall_colour), np.asarray(-shade.light[2]))
+        palette[ID_WALL] = lit(scene.wall_colour, "wall")
         if scene.posters:
             x, y = dx * zw, h + dy * zw
             for i, p in enumerate(scene.posters):
-                palette[ID_POSTER + i] = shade(np.asarray(p.colour), np.asarray(-shade.light[2]))
+                if p.emission > 0:
+                    glow.append(ID_POSTER + i)
+                    palette[ID_POSTER + i] = np.multiply(p.colour, p.emission)
+                else:
+                    palette[ID_POSTER + i] = lit(p.colour, "wall")
                 m = wall & (x >= p.x_min_m) & (x <= p.x_max_m) & (y >= p.bottom_m) & (y <= p.top_m)
                 ident[m] = ID_POSTER + i
-    return Hits(t, ident, np.take(palette, ident, axis=0))
+    rad = np.take(palette, ident, axis=0)
+    if rich:
+        surf = (ident != ID_BACKGROUND) & ~np.isin(ident, glow)
+        flat = surf.ravel()
+        if flat.any():
+            normal = np.where((ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER)),
+                              1, 0).ravel()[flat]
+            normals = np.where(normal[:, None] == 1, [[0.0, 1.0, 0.0]], [[0.0, 0.0, -1.0]])
+            pts = _points(dx, dy, h, t).reshape(-1, 3)[flat]
+            shaded = shade.rich(rad.reshape(-1, 3)[flat], normals, pts)
+            rad.reshape(-1, 3)[flat] = shaded
+    return Hits(t, ident, rad)
 
 
 def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shader,
@@ -170,7 +121,12 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
         nx, nz = (dx[side] * ts - c.x) / c.r, (ts - c.z) / c.r
         seg = np.clip(np.searchsorted(c.bounds, ys, side="right") - 1, 0, len(c.bounds) - 1)
         hits.t[side], hits.ident[side] = ts, c.ident + seg
-        hits.rad[side] = shade(c.colours[seg], nx * shade.light[0] + nz * shade.light[2])
+        if shade.plain:
+            hits.rad[side] = shade(c.colours[seg], nx * shade.light[0] + nz * shade.light[2])
+        else:
+            n = np.stack([nx, np.zeros_like(nx), nz], axis=-1)
+            pts = np.stack([dx[side] * ts, ys, ts], axis=-1)
+            hits.rad[side] = shade.rich(c.colours[seg], n, pts, c.glossy)
     if h > c.y1:
         yc, sign, part = c.y1, 1.0, PARTS - 1
     elif h < c.y0:
@@ -183,7 +139,11 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
     cap = (tc > 0.0) & ((xc - c.x) ** 2 + (tc - c.z) ** 2 <= c.r * c.r) & (tc < hits.t)
     if cap.any():
         hits.t[cap], hits.ident[cap] = tc[cap], c.ident + part
-        hits.rad[cap] = shade(c.cap, np.full(int(cap.sum()), sign * shade.light[1]))
+        if shade.plain:
+            hits.rad[cap] = shade(c.cap, np.full(int(cap.sum()), sign * shade.light[1]))
+        else:
+            pts = np.stack([xc[cap], np.full(int(cap.sum()), yc), tc[cap]], axis=-1)
+            hits.rad[cap] = shade.rich(c.cap, np.array([0.0, sign, 0.0]), pts)
 
 
 def trace_box(dx: np.ndarray, dy: np.ndarray, h: float, b: Cuboid, shade: Shader,
@@ -202,9 +162,42 @@ def trace_box(dx: np.ndarray, dy: np.ndarray, h: float, b: Cuboid, shade: Shader
     tn, xn, yn = tnear[hit], txn[hit], tyn[hit]
     face = np.where(tn == xn, np.where(dx[hit] > 0, 0, 1), np.where(tn == yn,
                     np.where(dy[hit] > 0, 2, 3), 4))
-    normals = np.array([[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1]], float)
     hits.t[hit], hits.ident[hit] = tn, b.ident + face
-    hits.rad[hit] = shade(b.colour, normals[face] @ shade.light)
+    if shade.plain:
+        hits.rad[hit] = shade(b.colour, _BOX_NORMALS[face] @ shade.light)
+    else:
+        hits.rad[hit] = shade.rich(b.colour, _BOX_NORMALS[face], _points(dx[hit], dy[hit], h, tn))
+
+
+def trace_obox(dx: np.ndarray, dy: np.ndarray, h: float, b: OBox, shade: Shader,
+               hits: Hits) -> None:
+    """Slab test in the box's own frame (turned about the vertical through its centre)."""
+    fwd, across = b.axes
+    # ray o + t·d with o = (0, h, 0) − centre, d = (dx, dy, 1), projected on each axis
+    oa, ob = -(b.x * fwd[0] + b.z * fwd[2]), -(b.x * across[0] + b.z * across[2])
+    da, db = dx * fwd[0] + fwd[2], dx * across[0] + across[2]
+    sa = np.where(da == 0.0, 1e-300, da)
+    sb = np.where(db == 0.0, 1e-300, db)
+    sy = np.where(dy == 0.0, 1e-300, dy)
+    ta0, ta1 = (-b.half_long - oa) / sa, (b.half_long - oa) / sa
+    tb0, tb1 = (-b.half_across - ob) / sb, (b.half_across - ob) / sb
+    ty0, ty1 = (b.y0 - h) / sy, (b.y1 - h) / sy
+    tan, tbn, tyn = np.minimum(ta0, ta1), np.minimum(tb0, tb1), np.minimum(ty0, ty1)
+    tnear = np.maximum(np.maximum(tan, tbn), tyn)
+    tfar = np.minimum(np.minimum(np.maximum(ta0, ta1), np.maximum(tb0, tb1)), np.maximum(ty0, ty1))
+    hit = (tnear <= tfar) & (tnear > 0.0) & (tnear < hits.t)
+    if not hit.any():
+        return
+    tn = tnear[hit]
+    face = np.where(tn == tan[hit], np.where(da[hit] > 0, 0, 1),
+                    np.where(tn == tbn[hit], np.where(db[hit] > 0, 2, 3),
+                             np.where(dy[hit] > 0, 4, 5)))
+    normals = np.stack([-fwd, fwd, -across, across, [0.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
+    hits.t[hit], hits.ident[hit] = tn, b.ident + face
+    if shade.plain:
+        hits.rad[hit] = shade(b.colour, normals[face] @ shade.light)
+    else:
+        hits.rad[hit] = shade.rich(b.colour, normals[face], _points(dx[hit], dy[hit], h, tn))
 
 
 def trace(dx: np.ndarray, dy: np.ndarray, h: float, prim: Primitive, shade: Shader,
@@ -212,5 +205,7 @@ def trace(dx: np.ndarray, dy: np.ndarray, h: float, prim: Primitive, shade: Shad
     """Intersect one primitive and keep the nearer hits."""
     if isinstance(prim, Cyl):
         trace_cylinder(dx, dy, h, prim, shade, hits)
+    elif isinstance(prim, OBox):
+        trace_obox(dx, dy, h, prim, shade, hits)
     else:
         trace_box(dx, dy, h, prim, shade, hits)

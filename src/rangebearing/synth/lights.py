@@ -1,0 +1,95 @@
+"""Shading: Lambert under a directional light and ambient, plus spots and highlights.
+
+:class:`Shader` keeps the original scalar form, ``albedo · (ambient + (1 −
+ambient)·max(0, n·l))``, for plain light (white, no spots, no gloss), so the
+original presets render bit for bit as before; :meth:`Shader.rich` handles
+coloured light, point lights with a cone and Blinn-Phong highlights, and needs
+each hit's normal and position.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Tuple
+
+import numpy as np
+
+from .scene import Scene
+
+
+@dataclass(frozen=True)
+class Shader:
+    """Light of one scene, ready to shade hits (unit direction towards the light)."""
+
+    light: np.ndarray
+    ambient: float
+    plain: bool = True
+    colour: np.ndarray = field(default_factory=lambda: np.ones(3))
+    ambient_colour: np.ndarray = field(default_factory=lambda: np.ones(3))
+    spot_pos: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    spot_axis: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    spot_power: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # intensity · colour
+    spot_cone: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # cos of the inner and outer half-angles
+    gloss: float = 0.0
+    shininess: float = 60.0
+    eye: Tuple[float, float, float] = (0.0, 0.1, 0.0)
+
+    @classmethod
+    def from_scene(cls, scene: Scene) -> Shader:
+        li = scene.lighting
+        d = np.asarray(li.direction, dtype=np.float64)
+        light = d / np.linalg.norm(d)
+        if li.plain:
+            return cls(light, float(li.ambient))
+        pos = np.array([s.position for s in li.spots], dtype=np.float64).reshape(-1, 3)
+        axis = np.array([s.target for s in li.spots], dtype=np.float64).reshape(-1, 3) - pos
+        axis /= np.maximum(np.linalg.norm(axis, axis=1, keepdims=True), 1e-12)
+        power = np.array([np.multiply(s.colour, s.intensity) for s in li.spots]).reshape(-1, 3)
+        cone = np.array([(np.cos(np.radians(s.cone_deg)), np.cos(np.radians(s.cone_deg + s.soft_deg)))
+                         for s in li.spots]).reshape(-1, 2)
+        return cls(light, float(li.ambient), False, np.asarray(li.colour, float),
+                   np.asarray(li.ambient_colour, float), pos, axis, power, cone,
+                   float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0))
+
+    def __call__(self, albedo: np.ndarray, cos: np.ndarray) -> np.ndarray:
+        """Plain Lambert: ``cos`` is n·l per hit; returns (..., 3) radiance."""
+        k = self.ambient + (1.0 - self.ambient) * np.maximum(cos, 0.0)
+        return np.asarray(albedo) * k[..., None]
+
+    def rich(self, albedo: np.ndarray, normal: np.ndarray, point: np.ndarray,
+             glossy: bool = False) -> np.ndarray:
+        """Radiance (K, 3) of hits with unit ``normal`` and ``point`` (K, 3), world frame."""
+        albedo = np.broadcast_to(np.asarray(albedo, dtype=np.float64), point.shape)
+        normal = np.broadcast_to(normal, point.shape)
+        cos = normal @ self.light
+        direct = (1.0 - self.ambient) * np.maximum(cos, 0.0)
+        irr = self.ambient * self.ambient_colour + direct[:, None] * self.colour
+        spec = np.zeros(point.shape) if glossy and self.gloss > 0 else None
+        view = None
+        if spec is not None:
+            view = np.asarray(self.eye) - point
+            view /= np.maximum(np.linalg.norm(view, axis=1, keepdims=True), 1e-12)
+            half = view + self.light
+            half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-12)
+            nh = np.clip(np.einsum("ij,ij->i", normal, half), 0.0, None)
+            spec += (direct > 0)[:, None] * (1.0 - self.ambient) * nh[:, None] ** self.shininess * self.colour
+        for pos, axis, power, (inner, outer) in zip(self.spot_pos, self.spot_axis, self.spot_power,
+                                                   self.spot_cone):
+            to = pos - point
+            d2 = np.maximum(np.einsum("ij,ij->i", to, to), 1e-6)
+            ldir = to / np.sqrt(d2)[:, None]
+            off = -ldir @ axis  # cos of the angle off the spot's axis
+            fall = np.clip((off - outer) / max(inner - outer, 1e-9), 0.0, 1.0)
+            fall = fall * fall * (3.0 - 2.0 * fall)
+            lam = np.maximum(np.einsum("ij,ij->i", normal, ldir), 0.0)
+            e = fall / d2
+            irr += (lam * e)[:, None] * power
+            if spec is not None and view is not None:
+                half = view + ldir
+                half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-12)
+                nh = np.clip(np.einsum("ij,ij->i", normal, half), 0.0, None)
+                spec += ((lam > 0) * e * nh**self.shininess)[:, None] * power
+        out = albedo * irr
+        if spec is not None:
+            out += self.gloss * spec
+        return out
