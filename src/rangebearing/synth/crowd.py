@@ -20,8 +20,8 @@ from typing import List, Optional
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from . import sampling as d
 from . import looks
+from . import sampling as d
 from .robots import apart, left_to_right, partner, robot, scatter, wall_behind
 from .scene import Box, LandmarkPose, Scene
 

@@ -26,8 +26,8 @@ from typing import List, Tuple
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from . import sampling as d
 from . import looks
+from . import sampling as d
 from .clutter import BLUE_PAINTS, RED_PAINTS
 from .robots import landmark_half_angle, left_to_right, partner, scatter, wall_behind
 from .scene import RGB, Box, Cylinder, FloorPatch, LandmarkPose, Poster, Scene
