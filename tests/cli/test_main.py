@@ -5,6 +5,7 @@ from __future__ import annotations
 import builtins
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -106,6 +107,29 @@ def test_run_check_resolves_destinations_and_names_the_file(tmp_path, capsys, mo
     assert main(["run", "--config", str(cfg), "--check"]) == 2
     err = capsys.readouterr().err
     assert f"{cfg}: 1 problem" in err and "no-such-robot.invalid" in err
+
+
+def test_run_starts_with_the_destinations_that_resolve(tmp_path, monkeypatch):
+    import socket
+
+    from rangebearing.net.client import Subscriber
+
+    real = socket.getaddrinfo
+
+    def no_dns(host, *args, **kw):  # never ask a real resolver from a test
+        if host == "no-such-robot.invalid":
+            raise socket.gaierror(socket.EAI_AGAIN, "Temporary failure in name resolution")
+        return real(host, *args, **kw)
+
+    monkeypatch.setattr(socket, "getaddrinfo", no_dns)
+    clip = Path(__file__).resolve().parents[2] / "samples" / "clip"
+    with Subscriber(port=0, timeout_s=2.0) as sub:
+        cfg = tmp_path / "c.yaml"
+        cfg.write_text(f'publish: {{unicast: ["no-such-robot.invalid:47800", "127.0.0.1:{sub.port}"]}}\n'
+                       f'source: {{kind: recorded, path: "{clip}", fps: 0}}\n')
+        assert main(["run", "--config", str(cfg)]) == 0
+        first = sub.recv()
+    assert first is not None and first.seq == 0
 
 
 @pytest.mark.parametrize("spec, message", [("picamera2:abc", "must be an integer"), ("recorded:", "source.path")])

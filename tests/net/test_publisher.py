@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import logging
 import socket
-from typing import Any, Iterator, List
+from typing import Any, Dict, Iterator, List
 
 import pytest
 
 from rangebearing.config import PublishConfig
-from rangebearing.errors import PublishError
 from rangebearing.net.client import Subscriber
 from rangebearing.net.protocol import encode_reading
 from rangebearing.net.publisher import MemoryPublisher, Publisher, UdpPublisher
@@ -130,24 +129,74 @@ def test_multicast_through_loopback() -> None:
     assert r.sender is not None and r.sender[0] == "127.0.0.1"  # left through lo
 
 
-def test_unresolvable_host_is_a_config_error(monkeypatch: pytest.MonkeyPatch) -> None:
+def _fake_dns(monkeypatch: pytest.MonkeyPatch, failures: Dict[str, List[int]]) -> None:
+    """Names in ``failures`` fail with the listed EAI codes in turn, then resolve to 127.0.0.1
+    (no name ever reaches a real resolver: the test sends no DNS query)."""
     real = socket.getaddrinfo
 
-    def fake(host: str, *args: Any, **kw: Any) -> List[Any]:
-        if host == "no-such-robot.invalid":
-            raise socket.gaierror(socket.EAI_NONAME, "Name or service not known")
-        return real(host, *args, **kw)
+    def fake(host: str, port: Any, *args: Any, **kw: Any) -> List[Any]:
+        if host in failures:
+            if failures[host]:
+                code = failures[host].pop(0)
+                raise socket.gaierror(code, "Temporary failure in name resolution" if code == socket.EAI_AGAIN
+                                      else "Name or service not known")
+            host = "127.0.0.1"
+        return real(host, port, *args, **kw)
 
     monkeypatch.setattr(socket, "getaddrinfo", fake)
-    cfg = PublishConfig(unicast=(("127.0.0.1", 47800), ("no-such-robot.invalid", 47800)))
-    with pytest.raises(PublishError, match=r"no-such-robot\.invalid"):
-        UdpPublisher(cfg)
 
 
-def test_multicast_interface_that_is_not_local_is_a_config_error() -> None:
+def test_an_unresolvable_host_does_not_stop_the_others(monkeypatch: pytest.MonkeyPatch, sub: Subscriber,
+                                                       caplog: pytest.LogCaptureFixture) -> None:
+    _fake_dns(monkeypatch, {"no-such-robot.invalid": [socket.EAI_NONAME] * 1000})
+    cfg = PublishConfig(unicast=(("no-such-robot.invalid", 47800), ("127.0.0.1", sub.port)))
+    with caplog.at_level(logging.WARNING), UdpPublisher(cfg, retry_s=0.01, max_retry_s=0.02) as pub:
+        assert len(pub.pending) == 1 and "no-such-robot.invalid" in pub.pending[0]
+        for seq in range(3):
+            pub.send(encode_reading("zumo", seq, 1.0))
+        stats = pub.stats
+    assert stats.sent[f"127.0.0.1:{sub.port}"] == 3
+    assert stats.errors == {"no-such-robot.invalid:47800": {"UNRESOLVED": 3}}
+    assert [r.seq for r in (sub.recv(), sub.recv(), sub.recv()) if r] == [0, 1, 2]
+    warnings = [r.getMessage() for r in caplog.records if "no-such-robot" in r.getMessage()]
+    assert len(warnings) == 1 and "retrying" in warnings[0]  # said once, not at every retry
+
+
+def test_dns_down_at_boot_is_retried_until_it_resolves(monkeypatch: pytest.MonkeyPatch,
+                                                       sub: Subscriber) -> None:
+    _fake_dns(monkeypatch, {"base-station.lan": [socket.EAI_AGAIN] * 3})
+    cfg = PublishConfig(unicast=(("base-station.lan", sub.port),))
+    with UdpPublisher(cfg, retry_s=0.01, max_retry_s=0.05) as pub:
+        assert pub.pending  # the only destination: the publisher starts anyway
+        pub.send(encode_reading("zumo", 0, 1.0))  # counted, not raised
+        seq = 1
+        while pub.pending and seq < 500:
+            sub.recv(timeout_s=0.01)
+            seq += 1
+        assert not pub.pending
+        pub.send(encode_reading("zumo", seq, 1.0))
+        stats = pub.stats
+    assert stats.errors[f"base-station.lan:{sub.port}"] == {"UNRESOLVED": 1}
+    r = sub.recv()
+    assert r is not None and r.seq == seq
+
+
+def test_multicast_interface_that_is_not_local_is_pending_not_fatal() -> None:
     cfg = PublishConfig(unicast=(), multicast_group=GROUP, multicast_interface="192.0.2.1")
-    with pytest.raises(PublishError, match="multicast_interface"):
-        UdpPublisher(cfg)
+    with UdpPublisher(cfg, retry_s=10.0) as pub:
+        assert len(pub.pending) == 1 and "multicast_interface" in pub.pending[0]
+        pub.send(encode_reading("zumo", 0, 1.0))
+        assert pub.stats.errors == {f"{GROUP}:47800": {"UNRESOLVED": 1}}
+
+
+def test_close_stops_the_retries_promptly(monkeypatch: pytest.MonkeyPatch) -> None:
+    _fake_dns(monkeypatch, {"never.invalid": [socket.EAI_NONAME] * 10**6})
+    pub = UdpPublisher(PublishConfig(unicast=(("never.invalid", 1),)), retry_s=0.01, max_retry_s=0.01)
+    retrier = pub._retrier
+    assert retrier is not None and retrier.is_alive()
+    pub.close()
+    retrier.join(timeout=2.0)
+    assert not retrier.is_alive()
 
 
 def test_send_after_close_is_a_no_op(sub: Subscriber) -> None:

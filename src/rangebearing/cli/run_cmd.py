@@ -11,7 +11,7 @@ from typing import Any, Callable, Optional
 from ..config import Config, check
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
-from ..errors import ConfigError, PublishError
+from ..errors import ConfigError
 from ..net.protocol import decode_reading
 from ..net.publisher import UdpPublisher
 from ..sources.base import FrameSource
@@ -42,11 +42,8 @@ def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
 
 
 def publisher_for(cfg: Config) -> UdpPublisher:
-    """The UDP publisher; a destination that does not resolve is a problem of the config file."""
-    try:
-        return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
-    except PublishError as exc:
-        raise ConfigError([str(exc)], cfg.source_file) from None
+    """The UDP publisher; a destination that does not resolve yet is retried in the background."""
+    return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
 
 
 def reloader(args: argparse.Namespace) -> Optional[Callable[[], Config]]:
@@ -72,7 +69,12 @@ def run(args: argparse.Namespace) -> int:
         cfg = dataclasses.replace(cfg, source=override)
         check(cfg)
     if args.check:
-        publisher_for(cfg).close()  # destinations resolve, multicast interface exists
+        pub = publisher_for(cfg)  # destinations resolve now, the multicast interface is up
+        pending = pub.pending
+        pub.close()
+        if pending:  # `run` would start and keep retrying these; --check says so
+            raise ConfigError([f"{p} (run would start without it and keep retrying)" for p in pending],
+                              cfg.source_file)
         print(f"{cfg.source_file}: OK")
         return 0
     echo = None

@@ -3,14 +3,17 @@
 :class:`UdpPublisher` never lets a network fault escape ``send()``: a dead
 receiver, a missing route or a full buffer must not stop the capture loop. Each
 fault is counted per destination and errno name (see :attr:`UdpPublisher.stats`)
-and logged at most once per destination every ``log_interval_s``.
+and logged at most once per destination every ``log_interval_s``. A destination
+that cannot be set up yet (its host does not resolve) is retried in the background.
 """
 
 from __future__ import annotations
 
 import errno
+import functools
 import logging
 import socket
+import threading
 import time
 from typing import Callable, Dict, List, Optional, Protocol, Tuple
 
@@ -78,39 +81,58 @@ def _resolve(host: str, port: int, key: str) -> Tuple[int, Tuple[str, int]]:
     return family, (str(sockaddr[0]), int(sockaddr[1]))
 
 
-class _Destination:
-    """One connected, non-blocking UDP socket; connected so ICMP errors come back to it."""
+Setup = Callable[[], Tuple[socket.socket, Tuple[str, int]]]
 
-    def __init__(self, name: str, sock: socket.socket, addr: Tuple[str, int]) -> None:
+
+class _Destination:
+    """One connected, non-blocking UDP socket; connected so ICMP errors come back to it.
+
+    ``sock`` is ``None`` while the destination is pending (its host did not
+    resolve yet, or its interface is not up): ``setup`` is retried in the background.
+    """
+
+    def __init__(self, name: str, setup: Setup) -> None:
         self.name = name
-        self.sock = sock
-        self.addr = addr
+        self.setup = setup
+        self.sock: Optional[socket.socket] = None
+        self.addr: Tuple[str, int] = ("", 0)
         self.connected = False
         self.sent = 0
         self.errors: Dict[str, int] = {}
         self.last_log_s: Optional[float] = None
         self.suppressed = 0
+        self.problem = ""  # why it is pending
 
     def send(self, payload: bytes) -> None:
         # Connecting lazily lets the daemon start before the network is up,
         # and reconnecting after an error picks up a changed route or address.
+        sock = self.sock
+        if sock is None:
+            raise _Pending()
         if not self.connected:
-            self.sock.connect(self.addr)
+            sock.connect(self.addr)
             self.connected = True
         try:
-            self.sock.send(payload)
+            sock.send(payload)
         except OSError:
             self.connected = False
             raise
 
 
+class _Pending(OSError):
+    """A send to a destination that is not set up yet (counted as UNRESOLVED)."""
+
+
 class UdpPublisher:
     """Sends each payload to every unicast destination and the multicast group.
 
-    Host names are resolved once, here: a name that does not resolve is a
-    configuration problem and raises :class:`~rangebearing.errors.PublishError`.
-    Multicast goes out of ``multicast_interface`` (``""`` lets the kernel pick)
-    with ``multicast_ttl`` and loopback on, so a listener on the same robot hears it.
+    A destination whose host does not resolve (a typo, or DNS not up yet at
+    boot) or whose multicast interface is not up yet does not stop the others:
+    it is logged, its sends are counted as ``UNRESOLVED``, and a background
+    thread retries it with back-off (``retry_s`` doubling to ``max_retry_s``)
+    until it works or the publisher is closed. Multicast goes out of
+    ``multicast_interface`` (``""`` lets the kernel pick) with ``multicast_ttl``
+    and loopback on, so a listener on the same robot hears it.
     """
 
     def __init__(
@@ -119,41 +141,67 @@ class UdpPublisher:
         logger: Optional[logging.Logger] = None,
         log_interval_s: float = 10.0,
         clock: Callable[[], float] = time.monotonic,
+        retry_s: float = 1.0,
+        max_retry_s: float = 30.0,
     ) -> None:
         self._log = logger or _log
         self._log_interval_s = log_interval_s
         self._clock = clock
         self._dests: List[_Destination] = []
         self._closed = False
-        try:
-            for host, port in dict.fromkeys(cfg.unicast):
-                family, addr = _resolve(host, port, "publish.unicast")
-                self._add(_name(host, port), socket.socket(family, socket.SOCK_DGRAM), addr)
-            if cfg.multicast_group:
-                self._add_multicast(cfg)
-        except BaseException:
-            self.close()
-            raise
+        self._lock = threading.Lock()
+        self._wake = threading.Event()
+        self._retry_s, self._max_retry_s = retry_s, max_retry_s
+        for host, port in dict.fromkeys(cfg.unicast):
+            self._dests.append(_Destination(_name(host, port), functools.partial(_unicast, host, port)))
+        if cfg.multicast_group:
+            group, port = cfg.multicast_group, cfg.multicast_port
+            self._dests.append(_Destination(_name(group, port), functools.partial(_multicast, cfg)))
+        for dest in self._dests:
+            self._try_setup(dest, first=True)
+        self._retrier: Optional[threading.Thread] = None
+        if self.pending:
+            self._retrier = threading.Thread(target=self._retry_pending, name="publish-resolver", daemon=True)
+            self._retrier.start()
 
-    def _add(self, name: str, sock: socket.socket, addr: Tuple[str, int]) -> None:
-        sock.setblocking(False)  # a full buffer is a counted EAGAIN, never a stall
-        self._dests.append(_Destination(name, sock, addr))
-
-    def _add_multicast(self, cfg: PublishConfig) -> None:
-        group, port = cfg.multicast_group, cfg.multicast_port
-        _, addr = _resolve(group, port, "publish.multicast_group")
-        iface = "0.0.0.0"
-        if cfg.multicast_interface:
-            _, (iface, _) = _resolve(cfg.multicast_interface, 0, "publish.multicast_interface")
-        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    def _try_setup(self, dest: _Destination, first: bool = False) -> bool:
         try:
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, cfg.multicast_ttl)
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(iface))
-        except OSError as exc:
-            sock.close()
-            raise PublishError(f"publish.multicast_interface: cannot send multicast from {iface!r}: {exc}") from None
-        self._add(_name(group, port), sock, addr)
+            sock, addr = dest.setup()
+        except PublishError as exc:
+            problem = str(exc)
+        except OSError as exc:  # EMFILE, ENOBUFS: try again later too
+            problem = f"{dest.name}: cannot open a socket: {exc.strerror or exc}"
+        else:
+            sock.setblocking(False)  # a full buffer is a counted EAGAIN, never a stall
+            with self._lock:
+                if self._closed:
+                    sock.close()
+                    return True
+                dest.addr, dest.sock = addr, sock
+            if not first:
+                self._log.warning("publishing to %s now (%s:%d)", dest.name, *addr)
+            return True
+        if first or problem != dest.problem:
+            self._log.warning("%s; sending to the other destinations and retrying it", problem)
+        dest.problem = problem
+        return False
+
+    def _retry_pending(self) -> None:
+        delay = self._retry_s
+        while not self._wake.wait(delay):
+            pending = [d for d in self._dests if d.sock is None]
+            if not pending:
+                return
+            for dest in pending:
+                if self._closed:
+                    return
+                self._try_setup(dest)
+            delay = min(delay * 2.0, self._max_retry_s)
+
+    @property
+    def pending(self) -> Tuple[str, ...]:
+        """Destinations not set up yet (host not resolved, interface not up), with the reason."""
+        return tuple(d.problem for d in self._dests if d.sock is None)
 
     def send(self, payload: bytes) -> None:
         """Send ``payload`` to every destination; faults are counted and logged, not raised."""
@@ -162,6 +210,8 @@ class UdpPublisher:
         for dest in self._dests:
             try:
                 dest.send(payload)
+            except _Pending:
+                dest.errors["UNRESOLVED"] = dest.errors.get("UNRESOLVED", 0) + 1
             except OSError as exc:
                 self._fault(dest, exc)
             else:
@@ -195,12 +245,39 @@ class UdpPublisher:
 
     def close(self) -> None:
         """Close every socket; later sends do nothing. Safe to call twice."""
-        self._closed = True
-        for dest in self._dests:
-            dest.sock.close()
+        with self._lock:
+            self._closed = True
+            socks = [d.sock for d in self._dests if d.sock is not None]
+        self._wake.set()
+        for sock in socks:
+            sock.close()
 
     def __enter__(self) -> UdpPublisher:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _unicast(host: str, port: int) -> Tuple[socket.socket, Tuple[str, int]]:
+    family, addr = _resolve(host, port, "publish.unicast")
+    return socket.socket(family, socket.SOCK_DGRAM), addr
+
+
+def _multicast(cfg: PublishConfig) -> Tuple[socket.socket, Tuple[str, int]]:
+    group, port = cfg.multicast_group, cfg.multicast_port
+    _, addr = _resolve(group, port, "publish.multicast_group")
+    iface = "0.0.0.0"
+    if cfg.multicast_interface:
+        _, (iface, _) = _resolve(cfg.multicast_interface, 0, "publish.multicast_interface")
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, cfg.multicast_ttl)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(iface))
+    except OSError as exc:
+        sock.close()
+        raise PublishError(
+            f"publish.multicast_interface: cannot send multicast from {iface!r} (not up yet?): {exc}"
+        ) from None
+    return sock, addr
