@@ -31,7 +31,7 @@ def test_required_fields_match_the_encoder(schema: Dict[str, Any]) -> None:
     bare = json.loads(encode_reading("zumo", 1, 2.0))
     assert sorted(schema["required"]) == sorted(bare)
     assert list(schema["required"]) == list(protocol.READING_FIELDS)
-    full = json.loads(encode_reading("zumo", 1, 2.0, [make_landmark()], fps=30.0, dropped=1))
+    full = json.loads(encode_reading("zumo", 1, 2.0, [make_landmark()], fps=30.0, dropped=1, omitted=2))
     assert set(full) == set(schema["properties"])
     optional = set(schema["properties"]) - set(schema["required"])
     assert optional == set(protocol.OPTIONAL_FIELDS)

@@ -50,7 +50,7 @@ def _decoder_accepts(data: bytes) -> bool:
     return True
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(DOCS, st.booleans())
 def test_every_datagram_the_schema_describes_is_decoded(doc: Dict[str, Any], ascii: bool) -> None:
     assert VALIDATOR.is_valid(doc), "the test strategy produced a document outside the schema"
@@ -60,7 +60,7 @@ def test_every_datagram_the_schema_describes_is_decoded(doc: Dict[str, Any], asc
     assert len(reading.landmarks) == len(doc["landmarks"]["range_m"])
 
 
-@settings(max_examples=500, deadline=None)
+@settings(max_examples=300, deadline=None)
 @given(DOCS, st.data(), st.booleans())
 def test_schema_and_decoder_agree_one_mutation_away(doc: Dict[str, Any], data: st.DataObject, ascii: bool) -> None:
     path = data.draw(st.sampled_from(ss.paths(doc)))

@@ -123,4 +123,6 @@ def format_reading(reading: Reading) -> str:
         extras.append(f"{reading.fps:.1f} fps")
     if reading.dropped:
         extras.append(f"{reading.dropped} dropped")
+    if reading.omitted:
+        extras.append(f"{reading.omitted} more not sent: datagram full")
     return f"{line}  [{', '.join(extras)}]" if extras else line

@@ -43,7 +43,7 @@ LANDMARK_FIELDS = (
     "red_px", "blue_px", "width_px",
 )
 READING_FIELDS = ("v", "robot", "seq", "t", "landmarks")  # required
-OPTIONAL_FIELDS = ("fps", "dropped")
+OPTIONAL_FIELDS = ("fps", "dropped", "omitted")
 
 
 class LandmarkLike(Protocol):
@@ -91,7 +91,9 @@ class Reading:
 
     ``t`` is the capture time in Unix seconds on the sender's clock. ``fps`` and
     ``dropped`` are ``None`` when the sender did not include them. ``sender`` is
-    the ``(host, port)`` the datagram came from, when known.
+    the ``(host, port)`` the datagram came from, when known. ``omitted`` counts
+    landmarks seen but left out because the datagram would not have fitted one
+    packet (the nearest were sent); ``None`` when nothing was left out.
     """
 
     robot: str
@@ -101,10 +103,12 @@ class Reading:
     fps: Optional[float] = None
     dropped: Optional[int] = None
     sender: Optional[Tuple[str, int]] = None
+    omitted: Optional[int] = None
 
     def to_bytes(self) -> bytes:
         """Encode this reading again (``sender`` is not part of the datagram)."""
-        return encode_reading(self.robot, self.seq, self.t, self.landmarks, self.fps, self.dropped)
+        return encode_reading(self.robot, self.seq, self.t, self.landmarks, self.fps, self.dropped,
+                              omitted=self.omitted)
 
 
 # --- encoding ---------------------------------------------------------------
@@ -166,6 +170,7 @@ def encode_reading(
     landmarks: Iterable[LandmarkLike] = (),
     fps: Optional[float] = None,
     dropped: Optional[int] = None,
+    omitted: Optional[int] = None,
 ) -> bytes:
     """Encode one frame's landmarks as a v1 datagram.
 
@@ -181,6 +186,8 @@ def encode_reading(
         Everything seen in the frame; empty is a heartbeat.
     fps, dropped : float, int, optional
         Frame statistics; left out of the datagram when ``None``.
+    omitted : int, optional
+        Landmarks seen but not in ``landmarks`` (see :func:`~rangebearing.net.fit.encode_fitting`).
 
     Returns
     -------
@@ -210,6 +217,8 @@ def encode_reading(
         msg["fps"] = _num(fps, FPS_DIGITS, "fps")
     if dropped is not None:
         msg["dropped"] = _count(dropped, "dropped")
+    if omitted is not None:
+        msg["omitted"] = _count(omitted, "omitted")
     return json.dumps(msg, separators=(",", ":"), allow_nan=False).encode("ascii")
 
 
@@ -376,4 +385,5 @@ def _reading(msg: Any, sender: Optional[Tuple[str, int]]) -> Reading:
         fps=_number(msg["fps"], "fps", 0.0) if "fps" in msg else None,
         dropped=_integer(msg["dropped"], "dropped") if "dropped" in msg else None,
         sender=sender,
+        omitted=_integer(msg["omitted"], "omitted") if "omitted" in msg else None,
     )
