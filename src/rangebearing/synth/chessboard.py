@@ -1,0 +1,112 @@
+"""Chessboard frames with known intrinsics, distortion and poses (for testing ``intrinsics``).
+
+A planar board of ``cols × rows`` inner corners (``cols+1 × rows+1`` squares,
+one square of white margin around) is seen under a pose ``(rvec, tvec)``
+(OpenCV convention: board point ``X`` is at ``R·X + t`` in the camera frame,
+x right, y down, z forward). Each pixel is the mean of ``s × s`` sub-pixel
+samples: every sample's ray is undistorted exactly (OpenCV's model inverted,
+:func:`.camera._undistort`), intersected with the board plane through the
+homography ``[r1 r2 t]``, and coloured by the square it lands in.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import List, NamedTuple, Tuple
+
+import cv2
+import numpy as np
+
+from ..core.intrinsics import board_points
+from ..core.types import CameraIntrinsics
+from .camera import _coefficients, _undistort
+
+BLACK, WHITE, BACKGROUND = 25.0, 230.0, 120.0
+
+
+class BoardView(NamedTuple):
+    """One rendered view: the BGR frame, its pose and the true corner pixels (N, 2)."""
+
+    image: np.ndarray
+    rvec: np.ndarray
+    tvec: np.ndarray
+    corners_px: np.ndarray
+
+
+def camera_matrix(cam: CameraIntrinsics) -> np.ndarray:
+    return np.array([[cam.fx_px, 0.0, cam.cx_px], [0.0, cam.fy_px, cam.cy_px], [0.0, 0.0, 1.0]])
+
+
+@functools.lru_cache(maxsize=4)
+def _sample_rays(cam: CameraIntrinsics, s: int) -> Tuple[np.ndarray, np.ndarray]:
+    off = (np.arange(s) + 0.5) / s - 0.5
+    u = (np.arange(cam.width_px)[:, None] + off[None, :]).ravel()
+    v = (np.arange(cam.height_px)[:, None] + off[None, :]).ravel()
+    uu, vv = np.meshgrid(u, v)
+    xd, yd = (uu - cam.cx_px) / cam.fx_px, (vv - cam.cy_px) / cam.fy_px
+    if cam.has_distortion:
+        xd, yd = _undistort(xd, yd, cam, _coefficients(cam))
+    return xd, yd
+
+
+def render_board(
+    cam: CameraIntrinsics, cols: int, rows: int, square_m: float, rvec: np.ndarray, tvec: np.ndarray, s: int = 3
+) -> np.ndarray:
+    """The board under one pose, (H, W, 3) uint8 BGR, anti-aliased by ``s × s`` supersampling."""
+    x, y = _sample_rays(cam, s)
+    r, _ = cv2.Rodrigues(np.asarray(rvec, np.float64))
+    hom = np.column_stack([r[:, 0], r[:, 1], np.asarray(tvec, np.float64).ravel()])
+    a = np.linalg.inv(hom)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = a[2, 0] * x + a[2, 1] * y + a[2, 2]
+        bu = (a[0, 0] * x + a[0, 1] * y + a[0, 2]) / w / square_m + 1.0  # in squares, 0 at the board's edge
+        bv = (a[1, 0] * x + a[1, 1] * y + a[1, 2]) / w / square_m + 1.0
+        on_board = (w > 0) & (bu >= -1) & (bu < cols + 2) & (bv >= -1) & (bv < rows + 2)
+        in_grid = (bu >= 0) & (bu < cols + 1) & (bv >= 0) & (bv < rows + 1)
+        dark = ((np.floor(bu) + np.floor(bv)) % 2 == 0) & in_grid
+    grey = np.where(on_board, np.where(dark, BLACK, WHITE), BACKGROUND)
+    grey = grey.reshape(cam.height_px, s, cam.width_px, s).mean(axis=(1, 3))
+    return np.repeat(np.clip(grey + 0.5, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
+
+
+def project_corners(
+    cam: CameraIntrinsics, cols: int, rows: int, square_m: float, rvec: np.ndarray, tvec: np.ndarray
+) -> np.ndarray:
+    """True pixel positions of the inner corners, (N, 2), distortion applied."""
+    obj = board_points(cols, rows, square_m).astype(np.float64)
+    pts, _ = cv2.projectPoints(obj, rvec, tvec, camera_matrix(cam), np.asarray(cam.distortion, np.float64))
+    return pts.reshape(-1, 2)
+
+
+def random_views(
+    cam: CameraIntrinsics, cols: int, rows: int, square_m: float, n: int, seed: int = 0, max_tilt_deg: float = 35.0
+) -> List[BoardView]:
+    """``n`` views of the board, tilted up to ``max_tilt_deg`` about random axes and spread over the frame.
+
+    Each view's board fills roughly 25–55 % of the frame width, and every
+    corner lies at least 12 px inside the frame.
+    """
+    rng = np.random.default_rng(seed)
+    size_m = (cols + 1) * square_m
+    centre = np.array([(cols - 1) * square_m / 2, (rows - 1) * square_m / 2, 0.0])
+    views: List[BoardView] = []
+    while len(views) < n:
+        tilt = math.radians(rng.uniform(5.0, max_tilt_deg))
+        axis_ang = rng.uniform(0, 2 * math.pi)
+        axis = np.array([math.cos(axis_ang), math.sin(axis_ang), 0.0])
+        spin = cv2.Rodrigues(np.array([0.0, 0.0, rng.uniform(-0.3, 0.3)]))[0]
+        r = cv2.Rodrigues(axis * tilt)[0] @ spin
+        width_frac = rng.uniform(0.25, 0.55)
+        z = cam.fx_px * size_m / (width_frac * cam.width_px)
+        target = np.array([rng.uniform(0.1, 0.9) * cam.width_px, rng.uniform(0.1, 0.9) * cam.height_px])
+        ray = np.array([(target[0] - cam.cx_px) / cam.fx_px, (target[1] - cam.cy_px) / cam.fy_px, 1.0])
+        t = ray * z - r @ centre  # the board's centre on the target pixel's (undistorted) ray
+        rvec = cv2.Rodrigues(r)[0].ravel()
+        corners = project_corners(cam, cols, rows, square_m, rvec, t)
+        m = 12.0
+        if not (np.all(corners >= m) and np.all(corners[:, 0] <= cam.width_px - 1 - m)
+                and np.all(corners[:, 1] <= cam.height_px - 1 - m)):
+            continue
+        views.append(BoardView(render_board(cam, cols, rows, square_m, rvec, t), rvec, t, corners))
+    return views
