@@ -88,3 +88,40 @@ def test_held_buffers_stall_the_camera(fake_picamera2: ModuleType) -> None:
     for request in list(fake_picamera2.WORLD.outstanding):
         request.release()
     cam.close()
+
+
+def grey(seq: int, h: int, w: int) -> np.ndarray:
+    return np.full((h, w, 3), 100, np.uint8)
+
+
+def test_controls_lock_exposure_and_white_balance_a_few_frames_later(fake_picamera2: ModuleType) -> None:
+    world = fake_picamera2.WORLD
+    world.producer = grey
+    world.auto_drift = lambda seq: 1.0 + 0.1 * seq  # AE chases what fills the frame
+    cam = started(fake_picamera2)
+
+    def grab() -> Any:
+        request = cam.capture_request(wait=0.5)
+        try:
+            return request.make_array("main")[0, 0].tolist(), request.get_metadata()
+        finally:
+            request.release()
+
+    pixel, md = grab()
+    assert pixel == [100, 100, 100]  # auto: the producer's frame as is
+    assert set(md) >= {"ExposureTime", "AnalogueGain", "ColourGains", "DigitalGain", "ScalerCrop", "Lux"}
+    assert md["ScalerCrop"] == (0, 2, 3280, 2460)  # the centred 4:3 window of the 3280×2464 array
+    locked = {"AeEnable": False, "ExposureTime": md["ExposureTime"], "AnalogueGain": md["AnalogueGain"],
+              "AwbEnable": False, "ColourGains": (world.auto_colour_gains[0] * 1.2, world.auto_colour_gains[1])}
+    cam.set_controls(locked)
+    assert world.set_controls_calls == [locked]
+    later = [grab() for _ in range(4)]
+    assert later[0][1]["ExposureTime"] != md["ExposureTime"]  # latency: still auto
+    pixel, md2 = later[-1]
+    assert md2["ExposureTime"] == md["ExposureTime"] and md2["ColourGains"][0] == pytest.approx(1.9 * 1.2)
+    # locked at frame 1's exposure (AE then wanted 1.1×) while AE would now pick 1.5×: 100·1.1/1.5 = 73,
+    # and red ×1.2 on top ([B, G, R] order)
+    assert pixel == [73, 73, 88]
+    with pytest.raises(RuntimeError, match="not advertised"):
+        cam.set_controls({"Bogus": 1})
+    cam.close()

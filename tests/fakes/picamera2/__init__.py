@@ -15,9 +15,19 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
 * Requests are reference counted and hold one of ``buffer_count`` buffers;
   when all are held, no frame can complete (the camera stalls).
 
+* ``set_controls()`` takes effect ``WORLD.control_latency_frames`` frames
+  later (libcamera applies controls a few frames on); ``ExposureTime`` or
+  ``AnalogueGain`` turn auto exposure off, ``ColourGains`` turns auto white
+  balance off, as the Pi IPA does. Every request's metadata reports
+  ``ExposureTime``, ``AnalogueGain``, ``DigitalGain``, ``ColourGains``,
+  ``ColourTemperature``, ``Lux``, ``AeLocked`` and ``ScalerCrop`` (picamera2's
+  ``examples/controls.py`` locks AE/AWB by copying the first three back).
+
 Frames are produced synchronously, one per pending job, from ``WORLD.producer``
-(RGB content). ``WORLD`` also stalls the sensor, skips frames (timestamp gaps),
-pads rows like old ``make_array`` did and makes ``stop()`` hang.
+(RGB content, as auto exposure and white balance would deliver it). With AE
+off, pixels scale by (exposure × gain) / (what AE would have chosen); with AWB
+off, red and blue scale by the set gain over the automatic one. ``WORLD`` also
+stalls the sensor, skips frames (timestamp gaps), pads rows like old ``make_array`` did and makes ``stop()`` hang.
 """
 
 from __future__ import annotations
@@ -62,6 +72,14 @@ class World:
         self.capture_waits: List[Any] = []
         self.outstanding: List[CompletedRequest] = []
         self.skip_next = 0
+        # what the AE/AWB algorithms settle on; ``auto_drift(seq)`` scales the exposure they pick
+        self.auto_exposure_us = 12000
+        self.auto_gain = 2.0
+        self.auto_colour_gains = (1.9, 1.6)
+        self.auto_drift: Callable[[int], float] = lambda seq: 1.0
+        self.control_latency_frames = 2
+        self.pixel_array = (3280, 2464)  # imx219
+        self.set_controls_calls: List[Dict[str, Any]] = []
 
     def set_stalled(self, stalled: bool) -> None:
         """Stall or resume the sensor; resuming completes jobs that are still queued."""
@@ -157,6 +175,8 @@ class Picamera2:
         self._seq = 0
         self._t0_ns = 0
         self.stop_calls = 0
+        self._pending: List[Any] = []  # (sequence number it applies from, controls)
+        self._applied: Dict[str, Any] = {}
 
     @staticmethod
     def global_camera_info() -> List[Dict[str, Any]]:
@@ -212,6 +232,17 @@ class Picamera2:
         main["stride"] = main["size"][0] * _BYTES_PER_PIXEL[main["format"]]
         config["main"] = main
         self.camera_config = config
+        self._applied = dict(controls)
+        self._pending = []
+
+    def set_controls(self, controls: Dict[str, Any]) -> None:
+        """Queue controls; they reach the frames ``control_latency_frames`` later."""
+        for name in controls:
+            if name not in _KNOWN_CONTROLS:
+                raise RuntimeError(f"Control {name} is not advertised by libcamera")
+        with WORLD.lock:
+            WORLD.set_controls_calls.append(dict(controls))
+            self._pending.append((self._seq + 1 + WORLD.control_latency_frames, dict(controls)))
 
     def camera_configuration(self) -> Optional[Dict[str, Any]]:
         return self.camera_config
@@ -274,12 +305,43 @@ class Picamera2:
             WORLD.outstanding.append(request)
             job.future.set_result(request)
 
+    def _exposure(self, w: int, h: int) -> Dict[str, Any]:
+        """Apply due controls; the metadata of the frame about to be made."""
+        while self._pending and self._pending[0][0] <= self._seq:
+            self._applied.update(self._pending.pop(0)[1])
+        c = self._applied
+        manual_ae = c.get("AeEnable") is False or "ExposureTime" in c or "AnalogueGain" in c
+        manual_awb = c.get("AwbEnable") is False or "ColourGains" in c
+        frame_us = int(self.camera_config["controls"]["FrameDurationLimits"][0])
+        auto_exp = WORLD.auto_exposure_us * WORLD.auto_drift(self._seq)  # AE's target exposure × gain
+        if manual_ae:
+            exp = min(int(c.get("ExposureTime", auto_exp)), frame_us)
+            gain = float(c.get("AnalogueGain", WORLD.auto_gain))
+        else:  # AE keeps the exposure inside the frame time and makes up with gain
+            exp = int(min(auto_exp, frame_us))
+            gain = WORLD.auto_gain * auto_exp / exp
+        gains = tuple(c.get("ColourGains", WORLD.auto_colour_gains)) if manual_awb else WORLD.auto_colour_gains
+        aw, ah = WORLD.pixel_array
+        cw, ch = (aw, round(aw * h / w)) if aw * h <= ah * w else (round(ah * w / h), ah)
+        return {
+            "ExposureTime": exp, "AnalogueGain": gain, "DigitalGain": 1.0,
+            "ColourGains": (float(gains[0]), float(gains[1])), "ColourTemperature": 4500, "Lux": 400.0,
+            "AeLocked": True, "ScalerCrop": ((aw - cw) // 2, (ah - ch) // 2, cw, ch),
+            "_scale": (exp * gain) / (auto_exp * WORLD.auto_gain),
+            "_wb": (gains[0] / WORLD.auto_colour_gains[0], gains[1] / WORLD.auto_colour_gains[1]),
+        }
+
     def _next_request(self) -> CompletedRequest:
         self._seq += 1 + WORLD.skip_next
         WORLD.skip_next = 0
         main = self.camera_config["main"]
         w, h = main["size"]
+        exposure = self._exposure(w, h)
+        scale, (wr, wb) = exposure.pop("_scale"), exposure.pop("_wb")
         rgb = np.asarray(WORLD.producer(self._seq, h, w), dtype=np.uint8)
+        if abs(scale - 1) > 1e-9 or abs(wr - 1) > 1e-9 or abs(wb - 1) > 1e-9:
+            k = np.array([scale * wr, scale, scale * wb], np.float32)
+            rgb = np.clip(rgb.astype(np.float32) * k + 0.5, 0, 255).astype(np.uint8)
         transform = self.camera_config["transform"]
         if transform.hflip:
             rgb = rgb[:, ::-1]
@@ -294,8 +356,7 @@ class Picamera2:
         metadata = {
             "SensorTimestamp": self._t0_ns + self._seq * period_ns + WORLD.sensor_clock_offset_ns,
             "FrameDuration": period_ns // 1000,
-            "ExposureTime": min(10000, duration_us),
-            "AnalogueGain": 1.0,
+            **exposure,
         }
         return CompletedRequest(self, np.ascontiguousarray(image), metadata)
 
