@@ -1,4 +1,4 @@
-"""Pieces shared by the command handlers: config and source options, progress, reading lines.
+"""Pieces shared by the command handlers: config and source options, config saving, progress, reading lines.
 
 Command modules import from here, never from each other.
 """
@@ -8,11 +8,15 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
+import os
+import shutil
 import sys
-from typing import Iterable, Iterator, Optional, TypeVar
+import tempfile
+from pathlib import Path
+from typing import Iterable, Iterator, Optional, TypeVar, Union
 
-from ..config import Config, SourceConfig, load_config
-from ..errors import ConfigError
+from ..config import Config, SourceConfig, dump_config, load_config
+from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
 
 T = TypeVar("T")
@@ -26,21 +30,67 @@ def config_from_args(args: argparse.Namespace) -> Config:
     return load_config(getattr(args, "config", None))
 
 
-def progress(items: Iterable[T], total: Optional[int], label: str, enabled: Optional[bool] = None) -> Iterator[T]:
-    """Yield ``items`` while drawing a progress bar on stderr when it is a terminal."""
+def add_quiet_arg(p: argparse.ArgumentParser, what: str = "the progress bar") -> None:
+    p.add_argument("-q", "--quiet", action="store_true", help=f"quiet: no {what}")
+
+
+def progress(
+    items: Iterable[T], total: Optional[int], label: str, enabled: Optional[bool] = None, unit: str = "frame"
+) -> Iterator[T]:
+    """Yield ``items`` while tqdm draws a progress bar on stderr, only when stderr is a terminal.
+
+    ``enabled=False`` (``-q``) hides it; ``None`` shows it on a terminal only,
+    so piped or logged output stays clean.
+    """
     show = sys.stderr.isatty() if enabled is None else enabled
-    n = 0
-    for n, item in enumerate(items, 1):
-        if show and (n % 5 == 0 or n == total):
-            if total:
-                done = int(30 * n / total)
-                sys.stderr.write(f"\r{label} [{'#' * done}{'.' * (30 - done)}] {n}/{total}")
-            else:
-                sys.stderr.write(f"\r{label} {n}")
-            sys.stderr.flush()
-        yield item
-    if show and n:
-        sys.stderr.write("\n")
+    if not show:
+        yield from items
+        return
+    from tqdm import tqdm  # imported here: only a terminal needs it
+
+    with tqdm(items, total=total, desc=label, unit=unit, file=sys.stderr, dynamic_ncols=True, leave=True) as bar:
+        yield from bar
+
+
+def quiet_or_auto(args: argparse.Namespace) -> Optional[bool]:
+    """``enabled`` for :func:`progress`: False with ``-q``, else decided by the terminal."""
+    return False if getattr(args, "quiet", False) else None
+
+
+def write_atomic(path: Union[str, Path], text: str) -> Optional[Path]:
+    """Write ``text`` to ``path`` atomically; an existing file is kept as ``path.bak``, returned.
+
+    The text goes to a temporary file in the same folder, flushed to disk, then
+    replaces ``path`` in one rename, so a crash leaves the old file or the new
+    one, never half of one.
+    """
+    out = Path(path)
+    backup = None
+    try:
+        if out.exists():
+            backup = out.with_name(out.name + ".bak")
+            shutil.copy2(out, backup)
+        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent or ".")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as f:
+                f.write(text)
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, out)
+        except BaseException:
+            os.unlink(tmp)
+            raise
+    except OSError as exc:
+        raise OutputError(f"cannot write {out}: {exc.strerror or exc}") from None
+    return backup
+
+
+def save_config(cfg: Config, path: Union[str, Path], header: str) -> None:
+    """Write a complete config (``header`` as comment lines on top) atomically, and say so on stderr."""
+    comment = "".join(f"# {line}\n" for line in header.splitlines())
+    backup = write_atomic(path, comment + dump_config(cfg))
+    note = f" (the old file is {backup})" if backup else ""
+    print(f"wrote {path}{note}", file=sys.stderr)
 
 
 def describe(lm: LandmarkLike) -> str:

@@ -28,6 +28,8 @@ COMMANDS: Dict[str, str] = {
     "calibrate": "fit the range model to frames with known range and bearing",
     "record": "save frames from a source as numbered images",
     "synth": "render synthetic frames with exact ground truth",
+    "intrinsics": "camera intrinsics and lens distortion from chessboard frames",
+    "tune": "lock exposure and white balance and fit the colour thresholds to a landmark in view",
 }
 
 EXIT_ERROR = 1
