@@ -130,10 +130,25 @@ class Picamera2Source:
         self._next_index = 0
         self._dropped = 0
         self._budget = TimeoutBudget(f"camera {cfg.camera_num}", cfg.timeout_s, cfg.retries)
+        self._metadata: Dict[str, Any] = {}
 
     @property
     def dropped(self) -> int:
         return self._dropped
+
+    @property
+    def metadata(self) -> Dict[str, Any]:
+        """The last frame's request metadata (``ExposureTime``, ``AnalogueGain``, ``ColourGains``, ``ScalerCrop``…)."""
+        return dict(self._metadata)
+
+    def set_controls(self, controls: Dict[str, Any]) -> None:
+        """Set libcamera controls on the running camera; they reach the frames a few frames later."""
+        if self._cam is None:
+            raise SourceError("Picamera2 source is not open")
+        try:
+            self._cam.set_controls(dict(controls))
+        except (RuntimeError, ValueError, TypeError) as exc:
+            raise CameraError(f"camera {self._cfg.camera_num}: cannot set controls {controls}: {exc}") from exc
 
     def open(self) -> None:
         """Acquire, configure and start the camera; CameraError if it cannot be done."""
@@ -212,6 +227,7 @@ class Picamera2Source:
         finally:
             request.release()
         self._budget.frame_arrived()
+        self._metadata = metadata
         if isinstance(array, np.ndarray) and array.ndim == 3:
             array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
         image = validate_frame(array)
