@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from rangebearing.core.calibrate import Sample
+from rangebearing.core.fit import Sample
 from rangebearing.core.focal_check import check_focal
 
 TRUE_FX, TRUE_CX = 634.0, 319.5

@@ -1,4 +1,4 @@
-"""``rangebearing calibrate``: fit the range model to frames with known range and bearing."""
+"""``rangebearing calibrate``: fit the range model to frames with known range and bearing (or guide a session)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,24 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..config import dump_config
+from ..config import Config
 from ..core.fit import Fit
-from ..errors import OutputError
-from ..evaluation.calibrate import calibrate
+from ..core.focal_check import FocalCheck
+from ..errors import CalibrationError, RangeBearingError
+from ..evaluation.calibrate import calibrate_checked
 from ..evaluation.truth import read_truth
 from ..sources.recorded import count_recorded, iter_recorded
-from .common import add_config_arg, config_from_args, progress
+from .common import (
+    add_config_arg,
+    add_quiet_arg,
+    add_source_args,
+    config_from_args,
+    progress,
+    quiet_or_auto,
+    save_config,
+)
+
+STRICT_EXIT = 3  # the config is written, but the bearings say the intrinsics are wrong
 
 
 def register(sub: Any) -> None:
@@ -22,13 +33,28 @@ def register(sub: Any) -> None:
         "calibrate",
         help="fit the range model to frames with known range and bearing",
         description="Detect landmarks in frames whose true range and bearing are known, fit the "
-        "model (config model.kind: pinhole or paper) and write a complete config that --config accepts.",
+        "model (config model.kind: pinhole or paper), check the focal length against the bearings "
+        "and write a complete config that --config accepts. With --guided, ask for the stations one "
+        "by one, check and record each live from --source, then fit.",
     )
-    p.add_argument("path", help="directory of images or a video file")
-    p.add_argument("--truth", required=True, metavar="FILE", help="CSV frame,range_m,bearing_rad")
+    p.add_argument("path", nargs="?", help="directory of images or a video file (not with --guided)")
+    p.add_argument("--truth", metavar="FILE", help="CSV frame,range_m,bearing_rad (required without --guided)")
     p.add_argument("--out", required=True, metavar="FILE", help="where to write the calibrated config (YAML)")
     add_config_arg(p)
     p.add_argument("--plot", metavar="FILE.png", help="plot measured against true range and the residuals")
+    p.add_argument("--strict", action="store_true",
+                   help=f"exit {STRICT_EXIT} when the bearings say the intrinsics are wrong (the config is written)")
+    p.add_argument("--fit-focal", action="store_true",
+                   help="when the bearings say the focal length is wrong, fit fx (fy by the same factor) and cx "
+                   "from them and refit the range model with that camera")
+    g = p.add_argument_group("guided calibration")
+    g.add_argument("--guided", action="store_true", help="ask for stations one by one and record them live")
+    g.add_argument("--plan", metavar="FILE", help="stations as CSV range_m,bearing_deg[,name] (+ left); "
+                   "default: 0.2-1.4 m straight ahead and across the field of view")
+    g.add_argument("--frames-per-station", type=int, default=5, metavar="N", help="frames per station (default 5)")
+    g.add_argument("--record", metavar="DIR", help="where to keep the frames and truth (default: OUT-recording/)")
+    add_source_args(p)
+    add_quiet_arg(p)
     p.set_defaults(func=run)
 
 
@@ -59,7 +85,7 @@ def plot_fit(fit: Fit, path: str) -> None:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        raise OutputError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
+        raise RangeBearingError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
     true = [r.range_m for r in fit.residuals]
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
     a.plot(true, [r.fitted_range_m for r in fit.residuals], "o", ms=3)
@@ -69,29 +95,51 @@ def plot_fit(fit: Fit, path: str) -> None:
     b.axhline(0, color="k", lw=1)
     b.set(xlabel="true range (m)", ylabel="range residual (%)", title="residuals")
     fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def report_focal(check: FocalCheck, refitted: bool, cfg: Config) -> None:
+    if check.suspect:
+        bar = "!" * 72
+        print(f"{bar}\nWARNING: {check.message}\n{bar}", file=sys.stderr)
+        if refitted:
+            c = cfg.camera
+            print(f"--fit-focal: camera set to fx_px {c.fx_px:.1f}, fy_px {c.fy_px:.1f}, cx_px {c.cx_px:.1f} "
+                  "and the range model refitted with it", file=sys.stderr)
+    else:
+        print(check.message)
+
+
+def fit_and_write(args: argparse.Namespace, cfg: Config, frames_dir: Path, truth_path: Path, source_note: str) -> int:
+    truth = read_truth(truth_path)
+
+    def frames() -> Any:
+        items = ((name, image, truth.get(name, [])) for name, image in iter_recorded(frames_dir))
+        return progress(items, count_recorded(frames_dir), "calibrate", quiet_or_auto(args))
+
     try:
-        fig.savefig(path, dpi=100)
-    except OSError as exc:
-        raise OutputError(f"--plot: cannot write {path}: {exc.strerror or exc}") from None
-    finally:
-        plt.close(fig)
+        new_cfg, fit, check, refitted = calibrate_checked(frames, cfg, fit_focal=args.fit_focal)
+    except KeyboardInterrupt:
+        print("\ninterrupted: nothing fitted, nothing written", file=sys.stderr)
+        return 130
+    print_fit(fit)
+    report_focal(check, refitted, new_cfg)
+    note = "camera fx, fy, cx refitted from the bearings (--fit-focal)" if refitted else check.message
+    save_config(new_cfg, args.out, f"rangebearing config written by 'rangebearing calibrate' from {source_note}\n"
+                f"bearing check: {note}")
+    if args.plot:
+        plot_fit(fit, args.plot)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    return STRICT_EXIT if args.strict and check.suspect and not refitted else 0
 
 
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
-    truth = read_truth(args.truth)
-    path = Path(args.path)
-    frames = ((name, image, truth.get(name, [])) for name, image in iter_recorded(path))
-    new_cfg, fit = calibrate(progress(frames, count_recorded(path), "calibrate"), cfg)
-    print_fit(fit)
-    out = Path(args.out)
-    header = f"# rangebearing config written by 'rangebearing calibrate' from {args.path}\n"
-    try:
-        out.write_text(header + dump_config(new_cfg), encoding="utf-8")
-    except OSError as exc:
-        raise OutputError(f"--out: cannot write {out}: {exc.strerror or exc}") from None
-    print(f"wrote {out}", file=sys.stderr)
-    if args.plot:
-        plot_fit(fit, args.plot)
-        print(f"wrote {args.plot}", file=sys.stderr)
-    return 0
+    if args.guided:
+        from .guided import run_guided_cmd  # only the guided session needs a live source
+
+        return run_guided_cmd(args, cfg)
+    if not args.path or not args.truth:
+        raise CalibrationError("give the frames PATH and --truth FILE, or --guided with a --source")
+    return fit_and_write(args, cfg, Path(args.path), Path(args.truth), args.path)

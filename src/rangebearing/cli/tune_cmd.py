@@ -17,9 +17,9 @@ from ..core.detect import downscale
 from ..core.pipeline import Pipeline
 from ..core.types import Landmark
 from ..errors import CalibrationError, FrameError
-from ..sources.base import FrameSource, open_source
-from .common import add_config_arg, config_from_args, save_config
-from .run_cmd import add_source_args, source_from_args
+from ..sources.base import FrameSource
+from ..sources.factory import open_source
+from .common import add_config_arg, add_source_args, config_from_args, save_config, source_from_args
 
 LATENCY_FRAMES = 6  # frames to discard after set_controls (libcamera applies controls a few frames on)
 
@@ -87,7 +87,7 @@ def find_landmark(frames: List[np.ndarray], cfg: Config) -> Tuple[List[Optional[
     """The nearest landmark in each frame with the loosest-needed step of :func:`search_ladder`, and that step."""
     det = cfg.detection
     for step, (red, blue, s, v) in enumerate(search_ladder(det.red_hue, det.blue_hue, det.s_min, det.v_min)):
-        pipe = Pipeline(_with_thresholds(cfg, red, blue, s, v), track=False)
+        pipe = Pipeline(_with_thresholds(cfg, red, blue, s, v).pipeline, track=False)
         found = [next(iter(pipe.process(f).landmarks), None) for f in frames]
         if sum(lm is not None for lm in found) * 2 > len(frames):
             return found, step
@@ -163,7 +163,7 @@ def run(args: argparse.Namespace) -> int:
     ranges = derive_ranges(red, blue)
     print("thresholds: " + describe(ranges))
     tuned = _with_thresholds(cfg, ranges.red_hue, ranges.blue_hue, ranges.s_min, ranges.v_min)
-    pipe = Pipeline(tuned, track=False)
+    pipe = Pipeline(tuned.pipeline, track=False)
     seen = [next(iter(pipe.process(f).landmarks), None) for f in frames]
     hits = [lm for lm in seen if lm is not None]
     if len(hits) < len(frames):

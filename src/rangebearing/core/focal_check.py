@@ -19,7 +19,7 @@ from typing import Sequence
 import numpy as np
 
 from .._compat import frozen
-from .calibrate import Sample
+from .fit import Sample
 
 MIN_SPREAD_RAD = math.radians(12.0)  # true bearings must span this much to fit the scale
 WARN_ERR_DEG = 0.5  # mean bearing error above which the intrinsics are suspect

@@ -41,7 +41,7 @@ def bad_config(tmp_path):
 def test_tune_locks_exposure_and_white_balance_and_fits_thresholds(camera, bad_config, tmp_path, capsys):
     before = load_config(bad_config)
     probe = render(scene(0.8, -0.15))
-    assert Pipeline(before, track=False).process(probe).landmarks == ()  # the old thresholds miss it
+    assert Pipeline(before.pipeline, track=False).process(probe).landmarks == ()  # the old thresholds miss it
 
     out = tmp_path / "tuned.yaml"
     assert main(["tune", "--config", str(bad_config), "--out", str(out), "--settle", "5", "--frames", "4"]) == 0
@@ -59,7 +59,7 @@ def test_tune_locks_exposure_and_white_balance_and_fits_thresholds(camera, bad_c
     assert tuned.detection.white_balance == "none"  # the camera's balance is fixed: no software one on top
 
     # the new thresholds find the landmark elsewhere in the same light, at the right place
-    found = Pipeline(tuned, track=False).process(probe).landmarks
+    found = Pipeline(tuned.pipeline, track=False).process(probe).landmarks
     assert len(found) == 1
     assert found[0].range_m == pytest.approx(0.8, rel=0.03)
     assert found[0].bearing_rad == pytest.approx(-0.15, abs=math.radians(0.5))
