@@ -1,127 +1,200 @@
-"""Can the daemon keep up? The real capture loop on a paced recording, publishing over loopback UDP."""
+"""The daemon as the robot runs it: ``rangebearing run`` in a subprocess, paced, publishing over loopback UDP.
+
+The recording (PNG frames, looped; the recorded source keeps decoded frames
+for looping, as a camera hands over decoded buffers) is paced at the asked
+frame rate. A listener on 127.0.0.1 stamps every datagram on arrival. From
+``/proc/<pid>``: CPU time (every thread's schedstat) over a window that
+starts once frames flow, RSS (VmRSS) and its peak (VmHWM). Latency is the
+datagram's arrival minus its ``t`` (the frame's capture time on the wall
+clock), so it covers capture → process → send → receive. Start-up is from
+``Popen`` to the first datagram. The subprocess inherits the benchmark's
+one-core affinity.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
+import shutil
+import signal
 import socket
+import subprocess
+import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
-from typing import List, Optional, Sequence
+from typing import List, Sequence, Tuple
 
 import cv2
 import numpy as np
 
 from rangebearing import Config
 from rangebearing._compat import frozen
-from rangebearing.config import PublishConfig, SourceConfig
-from rangebearing.daemon.loop import Daemon
-from rangebearing.daemon.sdnotify import Notifier
-from rangebearing.net.publisher import UdpPublisher
-from rangebearing.sources.base import Frame, FrameSource
-from rangebearing.sources.factory import open_source
+from rangebearing.config import PublishConfig, SourceConfig, dump_config
 
-END = b"END"  # not JSON, so never a reading
+SETTLE_S = 0.5  # after the first datagram, before the CPU window opens
 
 
 @frozen
 class DaemonFigures:
-    """The keep-up run's outcome (latency is capture to send, from ``Daemon.summary()``)."""
+    """One paced run of the daemon subprocess."""
 
     fps_asked: float
     duration_s: float
-    frames_expected: int
-    frames: int
-    dropped: int
-    bad_frames: int
-    achieved_fps: float
+    startup_s: float  # Popen → first datagram
+    frames_expected: int  # in the measuring window
+    received: int  # datagrams in the window
+    dropped: int  # the daemon's own count ("dropped" in the datagrams), over the window
+    seq_gaps: int  # frames missing between consecutive seq numbers (lost datagrams)
+    cpu_pct: float  # of one core, over the window
+    cpu_ms_per_frame: float
     latency_ms_p50: float
     latency_ms_p99: float
-    stage_ms: str
-    received: int
+    latency_ms_max: float
+    rss_mib: float
+    rss_peak_mib: float
     exit_code: int
+    error: str = ""
 
 
-class FirstFrames:
-    """A frame source that ends after frame index ``limit - 1`` (the looped recording would not end)."""
+def _command() -> List[str]:
+    script = Path(sys.executable).with_name("rangebearing")
+    if script.exists():
+        return [str(script)]
+    exe = shutil.which("rangebearing")
+    if exe:
+        return [exe]
+    return [sys.executable, "-c", "import sys; from rangebearing.cli.main import main; sys.exit(main())"]
 
-    def __init__(self, inner: FrameSource, limit: int) -> None:
-        self._inner = inner
-        self._limit = limit
 
-    def open(self) -> None:
-        self._inner.open()
+def _cpu_s(pid: int) -> float:
+    """CPU time of a process, all its threads, seconds.
 
-    def read(self) -> Optional[Frame]:
-        frame = self._inner.read()
-        return None if frame is None or frame.index >= self._limit else frame
+    The sum of each thread's ``schedstat`` run time (nanoseconds); threads that
+    ended are lost from it, so the window's threads must live through it (the
+    daemon's do). Falls back to utime + stime (clock ticks) without schedstat.
+    """
+    total, found = 0, False
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            total += int((task / "schedstat").read_text().split()[0])
+            found = True
+        except (OSError, ValueError, IndexError):
+            continue
+    if found:
+        return total / 1e9
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _status_kib(pid: int, key: str) -> float:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith(key + ":"):
+            return float(line.split()[1])
+    return float("nan")
+
+
+class Listener:
+    """Receives datagrams on 127.0.0.1, keeping (arrival wall time, arrival monotonic ns, message)."""
+
+    def __init__(self) -> None:
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.sock.bind(("127.0.0.1", 0))
+        self.sock.settimeout(0.2)
+        self.port = self.sock.getsockname()[1]
+        self.got: List[Tuple[float, float, dict]] = []
+        self.first = threading.Event()
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                data = self.sock.recv(65536)
+            except OSError:
+                continue
+            now, mono = time.time(), time.perf_counter()
+            try:
+                self.got.append((now, mono, json.loads(data)))
+            except ValueError:
+                continue
+            self.first.set()
 
     def close(self) -> None:
-        self._inner.close()
-
-    @property
-    def dropped(self) -> int:
-        return self._inner.dropped
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self.sock.close()
 
 
-def _drain(sock: socket.socket, got: List[int]) -> None:
-    while True:
-        try:
-            data = sock.recv(65536)
-        except OSError:  # timed out: the sender is gone
-            return
-        if data == END:
-            return
-        got[0] += 1
-
-
-def daemon_check(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s: float) -> DaemonFigures:
-    """Run :class:`~rangebearing.daemon.Daemon` in-process on ``frames`` (PNG, looped) paced at ``fps``.
-
-    ``cfg`` carries the camera; tracking is whatever ``cfg.detection.tracking`` says (on by default).
-    Readings go to a socket bound on 127.0.0.1, which counts them.
-    """
-    limit = round(fps * duration_s)
-    with tempfile.TemporaryDirectory(prefix="rb-bench-") as tmp, socket.socket(
-        socket.AF_INET, socket.SOCK_DGRAM
-    ) as rx:
+def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s: float) -> DaemonFigures:
+    """Run ``rangebearing run`` on ``frames`` (PNG, looped) paced at ``fps``; measure it from outside."""
+    with tempfile.TemporaryDirectory(prefix="rb-bench-") as tmp:
+        clip = Path(tmp) / "clip"
+        clip.mkdir()
         for i, frame in enumerate(frames):
-            cv2.imwrite(str(Path(tmp) / f"{i:06d}.png"), frame)
-        rx.bind(("127.0.0.1", 0))
-        rx.settimeout(duration_s + 30.0)
-        port = rx.getsockname()[1]
-        got = [0]
-        drainer = threading.Thread(target=_drain, args=(rx, got), daemon=True)
-        drainer.start()
+            cv2.imwrite(str(clip / f"{i:06d}.png"), frame)
+        listener = Listener()
         run_cfg = dataclasses.replace(
             cfg,
-            source=SourceConfig(kind="recorded", path=tmp, fps=fps, loop=True),
-            publish=PublishConfig(unicast=(("127.0.0.1", port),)),
+            source=SourceConfig(kind="recorded", path=str(clip), fps=fps, loop=True),
+            publish=PublishConfig(robot_id="bench", unicast=(("127.0.0.1", listener.port),)),
         )
-
-        def open_src(c: Config, sleep) -> FrameSource:
-            return FirstFrames(open_source(c.source, c.camera, sleep=sleep), limit)
-
-        daemon = Daemon(run_cfg, open_src, lambda c: UdpPublisher(c.publish), Notifier(environ={}))
+        conf = Path(tmp) / "bench.yaml"
+        conf.write_text(dump_config(run_cfg), encoding="utf-8")
+        log = open(Path(tmp) / "daemon.log", "w+", encoding="utf-8")  # noqa: SIM115 - read back below
+        env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+        env.pop("NOTIFY_SOCKET", None)
         t0 = time.perf_counter()
-        code = daemon.run()
-        wall = time.perf_counter() - t0
-        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
-            tx.sendto(END, ("127.0.0.1", port))
-        drainer.join(timeout=10.0)
-    s = daemon.summary()
+        proc = subprocess.Popen([*_command(), "run", "--config", str(conf)], stdout=log, stderr=log, env=env)
+        error, code = "", -1
+        try:
+            if not listener.first.wait(30.0):
+                raise RuntimeError("no datagram within 30 s")
+            startup = listener.got[0][1] - t0
+            time.sleep(SETTLE_S)
+            c0, w0, n0 = _cpu_s(proc.pid), time.perf_counter(), len(listener.got)
+            time.sleep(duration_s)
+            c1, w1, n1 = _cpu_s(proc.pid), time.perf_counter(), len(listener.got)
+            rss, hwm = _status_kib(proc.pid, "VmRSS"), _status_kib(proc.pid, "VmHWM")
+        except (RuntimeError, OSError) as exc:
+            error = str(exc)
+        finally:
+            proc.send_signal(signal.SIGTERM)
+            try:
+                code = proc.wait(timeout=10.0)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                code = proc.wait()
+            listener.close()
+            log.seek(0)
+            tail = log.read()[-2000:]
+            log.close()
+        if error:
+            return DaemonFigures(fps, duration_s, float("nan"), 0, 0, 0, 0, *([float("nan")] * 8), code,
+                                 f"{error}; log: {tail}")
+    window = listener.got[n0:n1]
+    lat = np.array([(arr - msg["t"]) * 1e3 for arr, _, msg in window]) if window else np.array([np.nan])
+    seqs = [msg["seq"] for _, _, msg in listener.got]
+    gaps = sum(max(0, b - a - 1) for a, b in zip(seqs, seqs[1:]))
+    cpu = (c1 - c0) / (w1 - w0)
     return DaemonFigures(
         fps_asked=fps,
-        duration_s=duration_s,
-        frames_expected=limit,
-        frames=s.frames,
-        dropped=s.dropped,
-        bad_frames=s.bad_frames,
-        achieved_fps=s.frames / wall if wall > 0 else 0.0,
-        latency_ms_p50=s.latency_ms_p50,
-        latency_ms_p99=s.latency_ms_p99,
-        stage_ms=", ".join(f"{k} {v:.2f}" for k, v in s.stage_ms.items()),
-        received=got[0],
+        duration_s=w1 - w0,
+        startup_s=startup,
+        frames_expected=round(fps * (w1 - w0)),
+        received=n1 - n0,
+        dropped=int(window[-1][2].get("dropped", 0)) - int(listener.got[max(0, n0 - 1)][2].get("dropped", 0))
+        if window else 0,
+        seq_gaps=gaps,
+        cpu_pct=100.0 * cpu,
+        cpu_ms_per_frame=1e3 * (c1 - c0) / max(1, n1 - n0),
+        latency_ms_p50=float(np.percentile(lat, 50)),
+        latency_ms_p99=float(np.percentile(lat, 99)),
+        latency_ms_max=float(lat.max()),
+        rss_mib=rss / 1024.0,
+        rss_peak_mib=hwm / 1024.0,
         exit_code=code,
     )

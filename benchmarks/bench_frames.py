@@ -1,10 +1,14 @@
-"""The benchmark's frames: one camera per resolution, N landmarks drifting, ArUco markers beside them.
+"""The benchmark's frames: one camera per resolution, N landmarks drifting, ArUco and AprilTag markers beside them.
 
 Every contender sees the same frames. A scenario's frames are consecutive
 moments of one smooth motion whose period is the number of frames, so cycling
 through them (as the tracking contender does) never jumps. The markers the
-ArUco contender looks for are painted into the linear radiance before the
-sensor model, so they get the same blur and noise as the landmarks.
+ArUco and AprilTag contenders look for (one of each per landmark) are painted
+into the linear radiance before the sensor model, so they get the same blur
+and noise as the landmarks.
+
+:func:`preset_scenario` draws the harder scenes instead (clutter, crowds,
+touching robots, moving sequences) from :mod:`rangebearing.synth` presets.
 """
 
 from __future__ import annotations
@@ -28,7 +32,9 @@ DRIFT_RAD = 0.010  # bearing amplitude of the drift (≈ 6 px at 640×480)
 DRIFT_RANGE_M = 0.02
 MARKER_SCALE = 1.3  # marker side / landmark image height
 NOISE = Imaging(blur_sigma_px=0.5, read_noise=0.004, shot_noise=0.0005)
-Marker = Tuple[int, int, int, int]  # x, y, side in px, id
+Marker = Tuple[int, int, int, int, str]  # x, y, side in px, id, kind ("aruco" | "apriltag")
+SEQUENCES = ("sample", "crowd-moving")  # presets whose frames are consecutive moments
+MIN_SIDE_PX = {"aruco": 12, "apriltag": 24}  # 6 and 8 cells of at least 2 and 3 px
 
 
 @dataclasses.dataclass
@@ -43,10 +49,16 @@ class ScenarioFrames:
     truth: List[Tuple[LandmarkPose, ...]]
     markers: List[Marker]
     marker_scale: float
+    scene_name: str = "clean"
+    sequence: bool = True  # consecutive moments of a motion (a tracker may follow them)
 
     @property
     def label(self) -> str:
         return f"{self.width_px}×{self.height_px}"
+
+    def count(self, kind: str) -> int:
+        """Markers of one kind drawn in every frame."""
+        return sum(m[4] == kind for m in self.markers)
 
 
 def pi_camera(width_px: int, height_px: int) -> CameraIntrinsics:
@@ -112,29 +124,33 @@ def _first_free(occ: np.ndarray, side: int, step: int) -> Optional[Tuple[int, in
     return int(xs[c]), int(ys[r])
 
 
-def place_markers(scenes: Sequence[Scene], sizes_px: Sequence[float]) -> Tuple[List[Marker], float]:
+def place_markers(
+    scenes: Sequence[Scene], sizes_px: Sequence[float], kinds: Sequence[str] = ("aruco",)
+) -> Tuple[List[Marker], float]:
     """Marker squares in free space away from every landmark; shrinks all of them until they fit.
 
-    Returns the markers (ids 0, 1, …) and the scale they were drawn at (1 = as asked).
+    Every kind gets one marker per size (ids 0, 1, … within a kind). Returns
+    the markers and the scale they were drawn at (1 = as asked).
     """
     if not sizes_px:
         return [], 1.0
     cam = scenes[0].camera
     step = max(1, cam.width_px // 160)
-    for scale in (1.0, 0.9, 0.8, 0.7, 0.6, 0.5):
+    wanted = [(kind, ident, size) for kind in kinds for ident, size in enumerate(sizes_px)]
+    for scale in (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.45, 0.4, 0.35, 0.3):
         occ = _occupied(scenes, pad_px=2 * step)
         placed: List[Marker] = []
-        for ident, size in sorted(enumerate(sizes_px), key=lambda t: -t[1]):
-            side = max(12, round(size * scale))
+        for kind, ident, size in sorted(wanted, key=lambda t: -t[2]):
+            side = max(MIN_SIDE_PX.get(kind, 12), round(size * scale))
             quiet = max(4, side // 6)  # one marker cell of wall around each marker
             spot = _first_free(occ, side + 2 * quiet, step)
             if spot is None:
                 break
             x, y = spot
             occ[y: y + side + 2 * quiet, x: x + side + 2 * quiet] = 1
-            placed.append((x + quiet, y + quiet, side, ident))
-        if len(placed) == len(sizes_px):
-            return sorted(placed, key=lambda m: m[3]), scale
+            placed.append((x + quiet, y + quiet, side, ident, kind))
+        if len(placed) == len(wanted):
+            return sorted(placed, key=lambda m: (m[4], m[3])), scale
     raise RuntimeError(f"cannot fit {len(sizes_px)} markers into a {cam.width_px}×{cam.height_px} frame")
 
 
@@ -143,7 +159,7 @@ def paint_markers(linear: np.ndarray, markers: Sequence[Marker], images: Sequenc
 
     Each marker is lit like the surface it covers (its mean radiance over a grey of 0.78).
     """
-    for (x, y, side, _), img in zip(markers, images):
+    for (x, y, side, *_), img in zip(markers, images):
         patch = linear[y: y + side, x: x + side]
         light = float(patch.mean()) / 0.78
         albedo = 0.05 + 0.80 * (img.astype(np.float64) / 255.0)
@@ -153,10 +169,14 @@ def paint_markers(linear: np.ndarray, markers: Sequence[Marker], images: Sequenc
 def build_scenario(
     base: Config, width_px: int, height_px: int, n: int, n_frames: int, seed: int, marker_images
 ) -> ScenarioFrames:
-    """Render ``n_frames`` noisy frames of ``n`` drifting landmarks with one ArUco marker per landmark.
+    """Render ``n_frames`` noisy frames of ``n`` drifting landmarks with one marker of each kind per landmark.
 
-    ``marker_images(ids_and_sides)`` returns the marker bitmaps (see :mod:`bench_aruco`).
+    ``marker_images`` maps a kind ("aruco", "apriltag") to a function
+    ``(ids_and_sides) -> bitmaps`` (see :mod:`bench_aruco`, :mod:`bench_apriltag`);
+    a bare function is taken as the ArUco one.
     """
+    if callable(marker_images):
+        marker_images = {"aruco": marker_images}
     cam = pi_camera(width_px, height_px)
     cfg = camera_config(base, cam)
     scenes = [
@@ -164,8 +184,8 @@ def build_scenario(
         for k in range(n_frames)
     ]
     heights = [cam.fy_px * base.landmark.height_m / lm.range_m for lm in poses(n, cam, 0.0)]
-    markers, scale = place_markers(scenes, [MARKER_SCALE * h for h in heights])
-    images = marker_images([(m[3], m[2]) for m in markers])
+    markers, scale = place_markers(scenes, [MARKER_SCALE * h for h in heights], tuple(marker_images))
+    images = [marker_images[m[4]]([(m[3], m[2])])[0] for m in markers]
     rng = np.random.default_rng(seed)
     frames = []
     for scene in scenes:
@@ -175,3 +195,35 @@ def build_scenario(
     return ScenarioFrames(
         width_px, height_px, n, cfg, frames, [s.landmarks for s in scenes], markers, MARKER_SCALE * scale
     )
+
+
+def preset_scenario(
+    base: Config, width_px: int, height_px: int, preset: str, n_frames: int, seed: int
+) -> ScenarioFrames:
+    """``n_frames`` frames of a :mod:`rangebearing.synth` preset, no markers.
+
+    Presets that are sequences (``sample``, ``crowd-moving``) give consecutive
+    moments; the others independent draws. The truth of a frame is what the
+    pipeline should find: every landmark the synth marks findable (the
+    crowd-proof presets' visibility), or every landmark of the scene.
+    """
+    from rangebearing.synth import scene_sequence
+
+    cam = pi_camera(width_px, height_px)
+    cfg = camera_config(base, cam)
+    rng = np.random.default_rng(seed)
+    scenes = list(scene_sequence(rng, preset, n_frames, cam))
+    frames = [develop(render_linear(s), s, rng) for s in scenes]
+    truth = [findable(s) for s in scenes]
+    n = max((len(t) for t in truth), default=0)
+    sequence = preset in SEQUENCES
+    return ScenarioFrames(width_px, height_px, n, cfg, frames, truth, [], 1.0, preset, sequence)
+
+
+def findable(scene: Scene) -> Tuple[LandmarkPose, ...]:
+    """The landmarks of a scene a detector should report (all of them when the synth has no visibility)."""
+    try:
+        from rangebearing.synth.visibility import landmark_visibility
+    except ImportError:
+        return tuple(scene.landmarks)
+    return tuple(lm for lm, vis in zip(scene.landmarks, landmark_visibility(scene)) if vis.findable)

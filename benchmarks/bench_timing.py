@@ -1,17 +1,25 @@
-"""Timing and memory of the contenders on one scenario's frames, and a check of what they found.
+"""CPU time (and wall time) of the contenders on one scenario's frames, cold and warm, and what they found.
 
-Every contender runs a warm-up pass over the frames (not timed), then the
-passes are interleaved (pass 1 of each contender, then pass 2 of each …), so a
-burst of background load hits all contenders alike. Only the call itself is
-timed. Peak memory is measured afterwards, in a separate pass under
-``tracemalloc`` (which slows allocation, so never while timing).
+**Cold and paced** (the headline): frame by frame, every contender processes
+the frame once, in a freshly shuffled order, each call after a sleep drawn
+from ``gap_s`` (the daemon sleeps 11–33 ms between frames at 30–90 fps), so
+each call finds the caches the way the daemon does: cooled by the sleep and
+by the other contenders' work. **Warm**: one untimed pass, then each
+contender runs over all frames back to back, passes interleaved; the old
+figure, kept beside the cold one.
+
+Each call is timed on the calling thread's CPU clock
+(``time.thread_time_ns``: what the robot's other programs and battery pay;
+OpenCV and the AprilTag library run on this thread, one core) and on the wall
+clock (``time.perf_counter_ns``: latency). Peak memory is measured afterwards,
+in a pass of its own under ``tracemalloc``.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import statistics
+import random
 import time
 import tracemalloc
 from typing import Callable, Dict, List, Optional, Sequence, Tuple
@@ -23,68 +31,111 @@ from rangebearing import Config, FrameResult, Pipeline
 from rangebearing._compat import frozen
 
 Process = Callable[[np.ndarray], object]
+PACED_GAP_S = (0.011, 0.033)
 
 
 @dataclasses.dataclass
 class Contender:
-    """A named way of processing a frame; ``expected`` is how many things it should report per frame."""
+    """A named way of processing a frame; ``expected(i)`` is how many things it should report in frame i."""
 
     name: str
     process: Process
-    expected: int
-    times_ns: List[int] = dataclasses.field(default_factory=list)
-    outputs: List[object] = dataclasses.field(default_factory=list)
-    run_medians_ns: List[float] = dataclasses.field(default_factory=list)
+    expected: Callable[[int], int]
+    what: str = "landmarks"  # or "markers"
+    warm_cpu_ns: List[int] = dataclasses.field(default_factory=list)
+    warm_wall_ns: List[int] = dataclasses.field(default_factory=list)
+    warm_tracked: List[bool] = dataclasses.field(default_factory=list)
+    cold_cpu_ns: List[int] = dataclasses.field(default_factory=list)
+    cold_wall_ns: List[int] = dataclasses.field(default_factory=list)
+    outputs: List[Tuple[int, object]] = dataclasses.field(default_factory=list)  # cold run: (frame index, output)
 
 
 @frozen
 class Figures:
-    """What one contender did on one scenario (times in milliseconds)."""
+    """What one contender did on one scenario (times in milliseconds per frame; CPU unless named wall)."""
 
     name: str
-    median_ms: float
-    p90_ms: float
-    spread_ms: Tuple[float, float]  # lowest and highest per-pass median
-    found: str  # e.g. "16/16 frames: 5 ✓"
+    cold_ms: float  # median CPU, cold and paced: the headline
+    cold_p90_ms: float
+    warm_ms: float  # median CPU, warm
+    wall_cold_ms: float
+    wall_cold_p99_ms: float
+    wall_warm_ms: float
+    found: str  # e.g. "5 of 5 landmarks ✓"
     found_ok: bool
     error: str  # worst range and bearing error against the truth, "" when not applicable
     peak_kib: float
-    tracked_median_ms: float = math.nan  # track only: frames searched in windows
-    all_mean_ms: float = math.nan  # track only: mean over every frame, full scans included
+    tracked_cold_ms: float = math.nan  # track only: frames searched in windows
+    tracked_warm_ms: float = math.nan
+    all_cold_mean_ms: float = math.nan  # track only: mean over every frame, full scans included
     tracked_share: float = math.nan
 
 
-def rangebearing_contenders(sc: ScenarioFrames, aruco: Optional[Process]) -> List[Contender]:
-    """paper, full, track and (if available) aruco, for one scenario."""
+def rangebearing_contenders(sc: ScenarioFrames, markers: Dict[str, Process]) -> List[Contender]:
+    """paper, full, track, and the marker detectors given (name → detect), for one scenario."""
     cfg: Config = sc.cfg
     paper = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, method="paper"))
+
+    def n_truth(i: int) -> int:
+        return len(sc.truth[i % len(sc.truth)])
+
     out = [
-        Contender("paper", Pipeline(paper.pipeline, track=False).process, sc.n_landmarks),
-        Contender("full", Pipeline(cfg.pipeline, track=False).process, sc.n_landmarks),
-        Contender("track", Pipeline(cfg.pipeline, track=True).process, sc.n_landmarks),
+        Contender("paper", Pipeline(paper.pipeline, track=False).process, n_truth),
+        Contender("full", Pipeline(cfg.pipeline, track=False).process, n_truth),
     ]
-    if aruco is not None:
-        out.append(Contender("aruco", aruco, len(sc.markers)))
+    if sc.sequence:  # tracking needs consecutive frames
+        out.append(Contender("track", Pipeline(cfg.pipeline, track=True).process, n_truth))
+    for name, detect in markers.items():
+        n = sc.count(name.split()[0])
+        out.append(Contender(name, detect, lambda i, n=n: n, "markers"))
     return out
 
 
-def run_timed(contenders: Sequence[Contender], frames: Sequence[np.ndarray], repeats: int) -> None:
-    """One warm-up pass, then ``repeats`` interleaved timed passes; fills times, outputs, run medians."""
-    clock = time.perf_counter_ns
+def _tracked(out: object) -> bool:
+    return isinstance(out, FrameResult) and out.tracked
+
+
+def run_warm(contenders: Sequence[Contender], frames: Sequence[np.ndarray], repeats: int) -> None:
+    """One untimed pass, then ``repeats`` passes of each contender over all frames, passes interleaved."""
+    cpu, wall = time.thread_time_ns, time.perf_counter_ns
     for c in contenders:
         for frame in frames:
             c.process(frame)
     for _ in range(repeats):
         for c in contenders:
-            fn, pass_ns = c.process, []
+            fn = c.process
             for frame in frames:
-                t0 = clock()
+                t0, w0 = cpu(), wall()
                 out = fn(frame)
-                t1 = clock()
-                pass_ns.append(t1 - t0)
-                c.outputs.append(out)
-            c.times_ns.extend(pass_ns)
-            c.run_medians_ns.append(statistics.median(pass_ns))
+                w1, t1 = wall(), cpu()
+                c.warm_cpu_ns.append(t1 - t0)
+                c.warm_wall_ns.append(w1 - w0)
+                c.warm_tracked.append(_tracked(out))
+
+
+def run_cold(
+    contenders: Sequence[Contender],
+    frames: Sequence[np.ndarray],
+    passes: int,
+    gap_s: Tuple[float, float] = PACED_GAP_S,
+    seed: int = 0,
+    sleep: Callable[[float], object] = time.sleep,
+) -> None:
+    """Frame by frame, every contender once in shuffled order, each call after a sleep drawn from ``gap_s``."""
+    cpu, wall = time.thread_time_ns, time.perf_counter_ns
+    rng = random.Random(seed)
+    order = list(contenders)
+    for _ in range(passes):
+        for i, frame in enumerate(frames):
+            rng.shuffle(order)
+            for c in order:
+                sleep(rng.uniform(*gap_s))
+                t0, w0 = cpu(), wall()
+                out = c.process(frame)
+                w1, t1 = wall(), cpu()
+                c.cold_cpu_ns.append(t1 - t0)
+                c.cold_wall_ns.append(w1 - w0)
+                c.outputs.append((i, out))
 
 
 def peak_kib(process: Process, frames: Sequence[np.ndarray]) -> float:
@@ -102,7 +153,8 @@ def peak_kib(process: Process, frames: Sequence[np.ndarray]) -> float:
     return worst / 1024.0
 
 
-def _count(out: object) -> int:
+def count(out: object) -> int:
+    """Landmarks in a FrameResult, or markers in a detector's id list/array (None: none)."""
     if isinstance(out, FrameResult):
         return len(out.landmarks)
     return 0 if out is None else len(out)  # type: ignore[arg-type]
@@ -110,16 +162,15 @@ def _count(out: object) -> int:
 
 def _errors(contender: Contender, sc: ScenarioFrames) -> str:
     """Worst relative range error and bearing error over the frames where the count was right."""
-    if contender.name == "aruco" or sc.n_landmarks == 0:
+    if contender.what != "landmarks" or sc.n_landmarks == 0:
         return ""
     worst_r = worst_b = -1.0
-    k = len(sc.frames)
-    for i, out in enumerate(contender.outputs):
+    for i, out in contender.outputs:
         if not isinstance(out, FrameResult):
             continue
-        truth = sorted(sc.truth[i % k], key=lambda lm: lm.bearing_rad)
+        truth = sorted(sc.truth[i % len(sc.truth)], key=lambda lm: lm.bearing_rad)
         got = sorted(out.landmarks, key=lambda lm: lm.bearing_rad)
-        if len(got) != len(truth):
+        if len(got) != len(truth) or not truth:
             continue
         for g, t in zip(got, truth):
             worst_r = max(worst_r, abs(g.range_m - t.range_m) / t.range_m)
@@ -130,42 +181,70 @@ def _errors(contender: Contender, sc: ScenarioFrames) -> str:
 
 
 def _found(contender: Contender, sc: ScenarioFrames) -> Tuple[str, bool]:
-    counts = [_count(o) for o in contender.outputs]
-    good = sum(c == contender.expected for c in counts)
-    ok = good == len(counts)
-    what = "markers" if contender.name == "aruco" else "landmarks"
-    text = f"{min(counts)}–{max(counts)}" if min(counts) != max(counts) else f"{counts[0]}"
-    note = " (≤ 1 by design)" if contender.name == "paper" and contender.expected > 1 else ""
-    return f"{text} of {contender.expected} {what} {'✓' if ok else '✗'}{note}", ok
+    """What it found per frame against what it should have, ✓ when every frame was right."""
+    got = [count(o) for _, o in contender.outputs]
+    want = [contender.expected(i) for i, _ in contender.outputs]
+    ok = got == want
+    good = sum(g == w for g, w in zip(got, want))
+    if min(want) == max(want):
+        text = f"{min(got)}–{max(got)}" if min(got) != max(got) else f"{got[0]}"
+        text = f"{text} of {want[0]} {contender.what}"
+    else:
+        text = f"{good}/{len(got)} frames right ({min(want)}–{max(want)} {contender.what})"
+    note = " (≤ 1 by design)" if contender.name == "paper" and max(want) > 1 else ""
+    return f"{text} {'✓' if ok else '✗'}{note}", ok
 
 
-def summarise(contender: Contender, sc: ScenarioFrames, peak: float) -> Figures:
-    """Median, p90 and spread of the timed frames, what was found, and the track-only figures."""
-    t = np.asarray(contender.times_ns, dtype=np.float64) / 1e6
-    found, ok = _found(contender, sc)
+def _median_ms(ns: Sequence[int], mask: Optional[np.ndarray] = None) -> float:
+    t = np.asarray(ns, dtype=np.float64) / 1e6
+    if mask is not None:
+        t = t[mask]
+    return float(np.median(t)) if t.size else math.nan
+
+
+def summarise(c: Contender, sc: ScenarioFrames, peak: float) -> Figures:
+    """Cold and warm medians, latency percentiles, what was found, and the track-only figures."""
+    cold = np.asarray(c.cold_cpu_ns, dtype=np.float64) / 1e6
+    wall = np.asarray(c.cold_wall_ns, dtype=np.float64) / 1e6
+    found, ok = _found(c, sc)
     extra: Dict[str, float] = {}
-    if contender.name == "track":
-        tracked = np.array([isinstance(o, FrameResult) and o.tracked for o in contender.outputs])
+    if c.name == "track":
+        tracked = np.array([_tracked(o) for _, o in c.outputs], bool)
         extra = {
-            "tracked_median_ms": float(np.median(t[tracked])) if tracked.any() else math.nan,
-            "all_mean_ms": float(t.mean()),
+            "tracked_cold_ms": _median_ms(c.cold_cpu_ns, tracked),
+            "tracked_warm_ms": _median_ms(c.warm_cpu_ns, np.array(c.warm_tracked, bool)),
+            "all_cold_mean_ms": float(cold.mean()),
             "tracked_share": float(tracked.mean()),
         }
     return Figures(
-        name=contender.name,
-        median_ms=float(np.median(t)),
-        p90_ms=float(np.percentile(t, 90)),
-        spread_ms=(min(contender.run_medians_ns) / 1e6, max(contender.run_medians_ns) / 1e6),
+        name=c.name,
+        cold_ms=float(np.median(cold)),
+        cold_p90_ms=float(np.percentile(cold, 90)),
+        warm_ms=_median_ms(c.warm_cpu_ns),
+        wall_cold_ms=float(np.median(wall)),
+        wall_cold_p99_ms=float(np.percentile(wall, 99)),
+        wall_warm_ms=_median_ms(c.warm_wall_ns),
         found=found,
         found_ok=ok,
-        error=_errors(contender, sc),
+        error=_errors(c, sc),
         peak_kib=peak,
         **extra,
     )
 
 
-def measure_scenario(sc: ScenarioFrames, repeats: int, aruco: Optional[Process]) -> Dict[str, Figures]:
-    """Time every contender on the scenario's frames, then measure its memory; figures by name."""
-    contenders = rangebearing_contenders(sc, aruco)
-    run_timed(contenders, sc.frames, repeats)
+def measure_scenario(
+    sc: ScenarioFrames,
+    repeats: int,
+    passes: int,
+    markers: Dict[str, Process],
+    gap_s: Tuple[float, float] = PACED_GAP_S,
+    seed: int = 0,
+) -> Dict[str, Figures]:
+    """Time every contender warm, then cold and paced, then measure its memory; figures by name."""
+    contenders = rangebearing_contenders(sc, markers)
+    run_warm(contenders, sc.frames, repeats)
+    for c in contenders:
+        if c.name == "track":  # start the cold run on a fresh track, like a daemon that just woke up
+            c.process = Pipeline(sc.cfg.pipeline, track=True).process
+    run_cold(contenders, sc.frames, passes, gap_s, seed)
     return {c.name: summarise(c, sc, peak_kib(c.process, sc.frames)) for c in contenders}

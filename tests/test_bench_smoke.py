@@ -7,6 +7,7 @@ printed figures (benchmarks/RESULTS.md), never in unit tests.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import math
 import subprocess
 import sys
@@ -14,6 +15,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Dict, List, Tuple
 
+import numpy as np
 import pytest
 
 from rangebearing import Config
@@ -22,15 +24,16 @@ from rangebearing.synth import Scene, landmark_bbox_px
 REPO = Path(__file__).resolve().parents[1]
 BENCH_DIR = REPO / "benchmarks"
 HEADINGS = (
-    "## Per-frame time (independent frames)",
+    "## Per-frame CPU time, cold and warm",
     "## Tracking (consecutive frames)",
-    "## Ratios (same run)",
-    "## Landmark count and pixel count (full)",
+    "## Ratios (same run",
+    "## Landmark count and pixel count (full, cold)",
     "## Stage breakdown",
-    "## Daemon keep-up",
+    "## Daemon (`rangebearing run` subprocess, paced recording)",
     "## Memory",
     "## Targets",
 )
+HAS_APRILTAG = importlib.util.find_spec("pupil_apriltags") is not None
 
 
 def bench_module(name: str) -> ModuleType:
@@ -70,37 +73,57 @@ def test_quick_run_exits_zero_and_prints_every_table(quick_run):
         assert heading in proc.stdout, heading
 
 
-def test_quick_run_figures_are_sane_and_the_pipeline_found_its_landmarks(quick_run):
+def test_quick_run_figures_are_sane_and_every_contender_found_what_it_should(quick_run):
     proc, _ = quick_run
-    rows = table_after(proc.stdout, "## Per-frame time")
-    full = {int(r["N"]): r for r in rows if r["contender"] == "full"}
-    assert set(full) == {0, 1, 10}
-    for n, row in full.items():
-        assert 0.0 < float(row["median ms"]) < 1000.0
-        assert float(row["median ms"]) <= float(row["p90 ms"])
+    rows = table_after(proc.stdout, "## Per-frame CPU time")
+    full = {r["scene"]: r for r in rows if r["contender"] == "full"}
+    assert {"N=0", "N=1", "N=10", "clutter", "sample"} <= set(full)
+    for n in (0, 1, 10):
+        row = full[f"N={n}"]
+        assert 0.0 < float(row["cold CPU ms"]) < 1000.0 and 0.0 < float(row["warm CPU ms"]) < 1000.0
+        assert float(row["cold CPU ms"]) <= float(row["cold p90"])
         assert row["found per frame"].startswith(f"{n} of {n} landmarks ✓")
-    worst_range_pct = float(full[1]["worst range / bearing error"].split("%")[0])
+    assert full["clutter"]["found per frame"].endswith("✓") and full["sample"]["found per frame"].endswith("✓")
+    worst_range_pct = float(full["N=1"]["worst range / bearing error"].split("%")[0])
     assert worst_range_pct < 5.0  # the readings are right, not just present
-    aruco = [r for r in rows if r["contender"] == "aruco"]
-    if aruco:  # OpenCV without cv2.aruco skips this contender
-        assert all("✓" in r["found per frame"] for r in aruco)
+    markers = [r for r in rows if r["contender"] in ("aruco", "apriltag d2", "apriltag d1")]
+    assert all("✓" in r["found per frame"] for r in markers), markers
+    names = {r["contender"] for r in markers}
+    if HAS_APRILTAG:
+        assert {"apriltag d2", "apriltag d1"} <= names
+        ten = [r for r in markers if r["scene"] == "N=10" and r["contender"] == "apriltag d2"]
+        assert ten and ten[0]["found per frame"].startswith("10 of 10 markers")
+    track = {r["scene"]: r for r in table_after(proc.stdout, "## Tracking")}
+    assert "clutter" not in track  # independent frames are not tracked
+    for scene in ("N=1", "N=10", "sample"):
+        assert track[scene]["found per frame"].endswith("✓"), track[scene]
+        assert float(track[scene]["tracked frames cold ms"]) > 0.0
 
 
-def test_quick_run_daemon_processed_and_published_every_frame(quick_run):
+def test_quick_run_daemon_subprocess_published_paced_frames(quick_run):
     proc, _ = quick_run
-    (row,) = table_after(proc.stdout, "## Daemon keep-up")
-    done, expected = (int(x) for x in row["frames processed"].split("/"))
-    assert expected == 90 and 0 < done <= expected  # 1 s at 90 fps; drops depend on the machine
-    assert int(row["datagrams received"]) == done
-    assert int(row["bad"]) == 0
+    rows = table_after(proc.stdout, "## Daemon")
+    assert [r["fps asked"] for r in rows] == ["30", "90"]
+    for row in rows:
+        sent, due = (int(x) for x in row["datagrams / frames due"].split("/"))
+        assert due == int(row["fps asked"]) and 0.8 * due <= sent <= due + 2  # 1 s window
+        assert 0.0 < float(row["start-up s (to 1st datagram)"]) < 30.0
+        assert 0.0 < float(row["CPU % of a core"]) < 100.0
+        rss, peak = (float(x) for x in row["RSS / peak MiB"].split("/"))
+        assert 10.0 < rss <= peak
+        assert row["exit"] == "0"  # SIGTERM ends it cleanly
 
 
 def test_quick_run_judges_every_target(quick_run):
     proc, _ = quick_run
     rows = table_after(proc.stdout, "## Targets")
-    assert len(rows) == 6
-    # INVALID means a contender missed landmarks it should have found: its time would mean nothing
+    judged = {r["target"].split(" (")[0] for r in rows}
+    assert len(rows) >= 9, rows
+    assert any("apriltag d2" in t for t in judged) and any("daemon at 90 fps" in t for t in judged)
+    # INVALID means a contender missed what it should have found: its time would mean nothing
     assert all(r["result"].split()[0] in ("PASS", "MISS", "n/a") for r in rows), rows
+    if HAS_APRILTAG:
+        assert all(r["result"] != "n/a" for r in rows), rows
 
 
 def test_out_file_has_the_machine_header_the_command_and_the_tables(quick_run):
@@ -113,13 +136,14 @@ def test_out_file_has_the_machine_header_the_command_and_the_tables(quick_run):
     assert proc.stdout.strip() in text
 
 
-def test_repeats_below_one_is_a_usage_error():
+@pytest.mark.parametrize("flag", ["--repeats", "--passes"])
+def test_repeats_or_passes_below_one_is_a_usage_error(flag):
     proc = subprocess.run(
-        [sys.executable, str(BENCH_DIR / "bench.py"), "--repeats", "0"],
+        [sys.executable, str(BENCH_DIR / "bench.py"), flag, "0"],
         cwd=REPO, capture_output=True, text=True, timeout=60, check=False,
     )
     assert proc.returncode == 2
-    assert "--repeats must be at least 1" in proc.stderr
+    assert f"{flag} must be at least 1" in proc.stderr
 
 
 @pytest.mark.parametrize(("w", "h"), [(320, 240), (640, 480), (1280, 720)])
@@ -139,9 +163,10 @@ def test_markers_sit_in_free_space_apart_from_landmarks_and_each_other(n):
     cam = frames.pi_camera(640, 480)
     scenes = [Scene(camera=cam, landmarks=frames.poses(n, cam, 2 * math.pi * k / 8), wall_distance_m=2.0)
               for k in range(8)]
-    markers, scale = frames.place_markers(scenes, [100.0] * n)
-    assert len(markers) == n and 0.5 <= scale <= 1.0
-    squares = [(x, y, x + s, y + s) for x, y, s, _ in markers]
+    markers, scale = frames.place_markers(scenes, [100.0] * n, ("aruco", "apriltag"))
+    assert len(markers) == 2 * n and 0.3 <= scale <= 1.0
+    assert sorted(m[3] for m in markers if m[4] == "apriltag") == list(range(n))
+    squares = [(x, y, x + s, y + s) for x, y, s, *_ in markers]
     for x0, y0, x1, y1 in squares:
         assert x0 >= 0 and y0 >= 0 and x1 <= 640 and y1 <= 480
         for scene in scenes:
@@ -151,3 +176,32 @@ def test_markers_sit_in_free_space_apart_from_landmarks_and_each_other(n):
     for i, a in enumerate(squares):
         for b in squares[i + 1:]:
             assert a[2] <= b[0] or b[2] <= a[0] or a[3] <= b[1] or b[3] <= a[1]
+
+
+def test_cold_run_interleaves_shuffled_contenders_with_a_sleep_before_every_call():
+    timing = bench_module("bench_timing")
+    calls, sleeps = [], []
+
+    def contender(name):
+        return timing.Contender(name, lambda frame, n=name: calls.append((n, int(frame[0, 0, 0]))), lambda i: 0)
+
+    cs = [contender(n) for n in "abcd"]
+    frames = [np.full((2, 2, 3), i, np.uint8) for i in range(6)]
+    timing.run_cold(cs, frames, passes=2, gap_s=(0.011, 0.033), seed=3, sleep=sleeps.append)
+    assert len(calls) == len(sleeps) == 4 * 6 * 2
+    assert all(0.011 <= s <= 0.033 for s in sleeps)
+    blocks = [calls[i:i + 4] for i in range(0, len(calls), 4)]
+    for k, block in enumerate(blocks):  # frame by frame: every contender once per frame, in frame order
+        assert sorted(n for n, _ in block) == list("abcd") and {f for _, f in block} == {k % 6}
+    assert len({tuple(n for n, _ in b) for b in blocks}) > 1  # the order is shuffled
+    assert all(len(c.cold_cpu_ns) == 12 and min(c.cold_cpu_ns) >= 0 for c in cs)
+
+
+@pytest.mark.skipif(not HAS_APRILTAG, reason="pupil-apriltags (the bench extra) is not installed")
+def test_painted_tag_bitmaps_are_the_apriltag_library_codes():
+    tags = bench_module("bench_apriltag")
+    grey = np.full((200, 400), 200, np.uint8)
+    for k, img in enumerate(tags.tag_images([(3, 64), (17, 64), (250, 64)])):
+        grey[40:104, 20 + 120 * k: 84 + 120 * k] = img
+    detect = tags.make_detector(2.0)
+    assert sorted(detect(np.dstack([grey] * 3))) == [3, 17, 250]
