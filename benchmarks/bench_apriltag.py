@@ -9,6 +9,7 @@ whether or not the detector is installed.
 
 from __future__ import annotations
 
+import atexit
 from typing import Callable, List, Optional, Sequence, Tuple
 
 import cv2
@@ -16,6 +17,19 @@ import numpy as np
 
 FAMILY = "tag36h11"
 DECIMATES = (2.0, 1.0)  # the library's default, and full resolution
+_LIVE: list = []  # every detector made, kept until exit (see _never_destroy)
+
+
+@atexit.register
+def _never_destroy() -> None:
+    """Leave the detectors to the OS at exit.
+
+    ``Detector.__del__`` frees the tag family before the detector that still
+    points into it and crashes the interpreter (SIGSEGV) now and then
+    (pupil-labs/apriltags #34, #46); with no pointer it frees nothing.
+    """
+    for detector in _LIVE:
+        detector.tag_detector_ptr = None
 
 
 def available() -> bool:
@@ -56,6 +70,7 @@ def make_detector(quad_decimate: float) -> Callable[[np.ndarray], Optional[List[
     from pupil_apriltags import Detector
 
     detector = Detector(families=FAMILY, nthreads=1, quad_decimate=quad_decimate)
+    _LIVE.append(detector)
 
     def detect(bgr: np.ndarray) -> List[int]:
         gray = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
