@@ -1,0 +1,259 @@
+"""Track identity: a stable id per neighbour, and its range and bearing rates.
+
+Every track is a constant-velocity Kalman filter on ``[range, range_rate,
+bearing, bearing_rate]``. Range and bearing are measured independently
+(diagonal measurement noise, the reading's own ``range_sigma_m`` and
+``bearing_sigma_rad``) and their process noises are independent, so the 4×4
+filter is exactly two 2×2 filters; they are written out in closed form and run
+over all tracks at once as arrays.
+
+Each frame (:func:`update`):
+
+1. predict every track to the frame time (white-noise acceleration model,
+   acceleration standard deviations from :class:`IdentityParams`);
+2. gate: squared Mahalanobis distance ``d²`` of each detection from each
+   prediction, with the innovation covariance (prediction plus the reading's
+   noise); pairs beyond ``gate_d2`` are never made;
+3. assign globally (:func:`~rangebearing.core.assignment.assign_gated`: the
+   most gated pairs, then the least total ``d²``; a Hungarian solver for
+   overlapping gates), update the matched tracks;
+4. unmatched tracks coast; one unmatched for more than ``max_hidden_frames``
+   frames in a row is dropped; each unmatched detection starts a track with
+   the next id.
+
+Ids come from a counter in :class:`IdentityState` that only grows, so an id is
+never reused while the state lives. The state is a value: :func:`update`
+returns a new one and never reads a clock.
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Sequence, Tuple
+
+import numpy as np
+
+from .._compat import frozen
+from .assignment import assign_gated
+
+RANGE, BEARING = 0, 1  # channels of the state and covariance arrays
+
+
+@frozen
+class IdentityParams:
+    """Association and filter settings; defaults suit Zumo-sized robots seen at 30 fps.
+
+    ``range_accel_mps2`` bounds the relative acceleration along the line of
+    sight; the bearing's acceleration is ``lateral_accel_mps2 / range`` plus
+    ``yaw_accel_radps2`` (the observer turning). They are the standard
+    deviations of a white-noise acceleration, half the acceleration bounds
+    (Bar-Shalom's rule for this model: 0.5 to 1 times the largest
+    acceleration; robots accelerate smoothly, so the lower end). The ``*_prior`` values are the
+    rate uncertainty of a new track; the ``min_*`` floors keep a reading with a
+    zero or tiny sigma from making the gate a point.
+    """
+
+    max_hidden_frames: int = 15
+    gate_d2: float = 16.0  # chi-square, 2 dof: a true pair falls outside once in ~3,000
+    range_accel_mps2: float = 0.75  # half of a 1.5 m/s² bound
+    lateral_accel_mps2: float = 0.75
+    yaw_accel_radps2: float = 1.0  # half of a 2 rad/s² bound
+    range_rate_prior_mps: float = 0.6
+    bearing_rate_prior_radps: float = 2.0
+    min_range_sigma_frac: float = 0.004  # of the range
+    min_bearing_sigma_rad: float = 0.001
+    nominal_dt_s: float = 1.0 / 30.0  # frame interval when the frames carry no time
+    max_dt_s: float = 1.0  # a longer gap is predicted as this long (a paused source)
+    rate_after_updates: int = 3  # rates are published from this many measurements on
+
+
+DEFAULT_PARAMS = IdentityParams()
+
+
+@frozen
+class IdentityState:
+    """Every live track, as arrays over tracks (``n`` rows), and the id counter.
+
+    ``x`` is ``(n, 2, 2)``: channel (range, bearing) × (value, rate) in metres,
+    m/s, radians, rad/s. ``p`` is ``(n, 2, 3)``: per channel the covariance
+    entries ``(var value, cov value-rate, var rate)``. ``hidden`` counts the
+    frames since a track was last measured, ``updates`` its measurements.
+    Treat the arrays as read-only.
+    """
+
+    ids: np.ndarray  # (n,) int64
+    x: np.ndarray
+    p: np.ndarray
+    hidden: np.ndarray  # (n,) int64
+    updates: np.ndarray  # (n,) int64
+    next_id: int = 0
+    t_s: Optional[float] = None  # time of the last frame, when the frames carry one
+
+    @property
+    def size(self) -> int:
+        return int(self.ids.shape[0])
+
+
+def empty_state(first_id: int = 0) -> IdentityState:
+    """No tracks; the next new track gets ``first_id``."""
+    z = np.zeros(0, dtype=np.int64)
+    return IdentityState(z, np.zeros((0, 2, 2)), np.zeros((0, 2, 3)), z, z, first_id, None)
+
+
+@frozen
+class Identified:
+    """What :func:`update` says about each detection of the frame (arrays over detections)."""
+
+    track_id: np.ndarray  # (m,) int64
+    range_rate_mps: np.ndarray  # (m,) float, NaN while the track is too young
+    bearing_rate_radps: np.ndarray
+
+
+def measurement_variance(
+    range_m: np.ndarray, range_sigma_m: np.ndarray, bearing_sigma_rad: np.ndarray, params: IdentityParams
+) -> np.ndarray:
+    """``(m, 2)`` variances of range and bearing readings, sigmas floored by ``params``."""
+    r = np.empty((range_m.shape[0], 2))
+    np.maximum(range_sigma_m, params.min_range_sigma_frac * np.abs(range_m), out=r[:, RANGE])
+    np.maximum(bearing_sigma_rad, params.min_bearing_sigma_rad, out=r[:, BEARING])
+    return np.square(r, out=r)
+
+
+def predict(x: np.ndarray, p: np.ndarray, dt_s: float, params: IdentityParams) -> Tuple[np.ndarray, np.ndarray]:
+    """Constant-velocity prediction ``dt_s`` ahead (discrete white-noise acceleration).
+
+    ``F = [[1, dt], [0, 1]]``, ``Q = a² [[dt⁴/4, dt³/2], [dt³/2, dt²]]`` per
+    channel, with ``a`` the range acceleration or the bearing acceleration
+    at the track's predicted range.
+    """
+    dt = float(dt_s)
+    xn = x.copy()
+    xn[:, :, 0] += dt * x[:, :, 1]
+    q = np.empty(x.shape[:2])
+    q[:, RANGE] = params.range_accel_mps2**2
+    q[:, BEARING] = np.square(params.lateral_accel_mps2 / np.maximum(xn[:, RANGE, 0], 0.05) + params.yaw_accel_radps2)
+    p01, p11 = p[:, :, 1], p[:, :, 2]
+    dt_p11 = dt * p11
+    pn = np.empty_like(p)
+    pn[:, :, 0] = p[:, :, 0] + dt * (2.0 * p01 + dt_p11) + q * (dt**4 / 4.0)
+    pn[:, :, 1] = p01 + dt_p11 + q * (dt**3 / 2.0)
+    pn[:, :, 2] = p11 + q * (dt * dt)
+    return xn, pn
+
+
+# Bearings are never wrapped: a camera sees less than ±90°, so a difference of
+# two bearings of one neighbour is far from ±π.
+
+
+def distances(x: np.ndarray, p: np.ndarray, z: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``(n, m)`` squared Mahalanobis distances of ``m`` readings ``z`` (``(m, 2)``, variances ``r``)
+    from ``n`` predicted tracks."""
+    innov = z[None, :, :] - x[:, None, :, 0]
+    return (np.square(innov) / (p[:, None, :, 0] + r[None, :, :])).sum(axis=2)
+
+
+def correct(x: np.ndarray, p: np.ndarray, z: np.ndarray, r: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Kalman update of matched tracks ``x, p`` (``(k, 2, ...)``) with readings ``z``, variances ``r``."""
+    innov = z - x[:, :, 0]
+    p00, p01 = p[:, :, 0], p[:, :, 1]
+    s = p00 + r
+    k0, k1 = p00 / s, p01 / s
+    xn = x.copy()
+    xn[:, :, 0] += k0 * innov
+    xn[:, :, 1] += k1 * innov
+    pn = np.empty_like(p)
+    pn[:, :, 0] = p00 - k0 * p00
+    pn[:, :, 1] = p01 - k0 * p01
+    pn[:, :, 2] = p[:, :, 2] - k1 * p01
+    return xn, pn
+
+
+def _dt(state: IdentityState, t_s: Optional[float], params: IdentityParams) -> float:
+    if t_s is None or state.t_s is None:
+        return params.nominal_dt_s
+    dt = t_s - state.t_s
+    if not dt > 0.0:  # a repeated or out-of-order stamp: assume the nominal interval
+        return params.nominal_dt_s
+    return min(dt, params.max_dt_s)
+
+
+def _births(state: IdentityState, z: np.ndarray, r: np.ndarray, params: IdentityParams) -> IdentityState:
+    """New tracks for readings ``z`` (``(k, 2)``), ids from the counter on."""
+    k = z.shape[0]
+    x0 = np.zeros((k, 2, 2))
+    x0[:, :, 0] = z
+    p0 = np.zeros((k, 2, 3))
+    p0[:, :, 0] = r
+    p0[:, RANGE, 2] = params.range_rate_prior_mps**2
+    p0[:, BEARING, 2] = params.bearing_rate_prior_radps**2
+    n = np.zeros(k, dtype=np.int64)
+    return IdentityState(state.next_id + np.arange(k, dtype=np.int64), x0, p0, n, n + 1, state.next_id + k)
+
+
+def update(
+    state: IdentityState,
+    range_m: Sequence[float],
+    bearing_rad: Sequence[float],
+    range_sigma_m: Sequence[float],
+    bearing_sigma_rad: Sequence[float],
+    t_s: Optional[float] = None,
+    params: Optional[IdentityParams] = None,
+) -> Tuple[IdentityState, Identified]:
+    """Associate one frame's readings with the tracks; returns the new state and each reading's id and rates.
+
+    Parameters
+    ----------
+    state : IdentityState
+        The tracks after the previous frame (:func:`empty_state` at the start of a run).
+    range_m, bearing_rad, range_sigma_m, bearing_sigma_rad : sequence of float
+        The frame's raw readings and their one-sigma uncertainties (equal length ``m``).
+    t_s : float, optional
+        Frame time in seconds on any steady clock. Without it (or on the first
+        frame, or when it does not advance) frames are taken to be
+        ``params.nominal_dt_s`` apart.
+    params : IdentityParams, optional
+        Defaults to ``IdentityParams()``.
+
+    Returns
+    -------
+    state : IdentityState
+    identified : Identified
+        Per reading, in input order: its track id (>= 0) and the filtered
+        range and bearing rates, NaN until the track has
+        ``params.rate_after_updates`` measurements.
+    """
+    m = len(range_m)
+    z = np.empty((m, 2))
+    z[:, RANGE] = range_m
+    z[:, BEARING] = bearing_rad
+    params = DEFAULT_PARAMS if params is None else params
+    r = measurement_variance(z[:, RANGE], np.asarray(range_sigma_m, float), np.asarray(bearing_sigma_rad, float),
+                             params)
+    x, p = predict(state.x, state.p, _dt(state, t_s, params), params)
+    rows, cols = assign_gated(distances(x, p, z, r), params.gate_d2)
+    hidden = state.hidden + 1
+    updates = state.updates.copy()
+    if rows.size:
+        x[rows], p[rows] = correct(x[rows], p[rows], z[cols], r[cols])
+        hidden[rows] = 0
+        updates[rows] += 1
+    ids, next_id = state.ids, state.next_id
+    det_row = np.full(m, -1, dtype=np.intp)
+    det_row[cols] = rows
+    if rows.size < m:  # readings no track took: new tracks, appended after the old ones
+        new = np.nonzero(det_row < 0)[0]
+        born = _births(state, z[new], r[new], params)
+        det_row[new] = ids.shape[0] + np.arange(new.size)
+        ids, next_id = np.concatenate([ids, born.ids]), born.next_id
+        x, p = np.concatenate([x, born.x]), np.concatenate([p, born.p])
+        hidden, updates = np.concatenate([hidden, born.hidden]), np.concatenate([updates, born.updates])
+    grown = updates[det_row] >= params.rate_after_updates
+    rates = x[det_row, :, 1]
+    identified = Identified(
+        track_id=ids[det_row],
+        range_rate_mps=np.where(grown, rates[:, RANGE], np.nan),
+        bearing_rate_radps=np.where(grown, rates[:, BEARING], np.nan),
+    )
+    keep = hidden <= params.max_hidden_frames
+    if not keep.all():
+        ids, x, p, hidden, updates = ids[keep], x[keep], p[keep], hidden[keep], updates[keep]
+    return IdentityState(ids, x, p, hidden, updates, next_id, t_s), identified
