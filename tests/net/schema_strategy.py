@@ -96,7 +96,7 @@ def same_length_columns(doc: Any) -> Any:
     """Cut every known landmark column to the shortest one's length (the one rule a schema cannot state)."""
     cols = doc.get("landmarks") if isinstance(doc, dict) else None
     if isinstance(cols, dict):
-        known = [k for k in protocol.LANDMARK_FIELDS if isinstance(cols.get(k), list)]
+        known = [k for k in (protocol.LANDMARK_FIELDS + protocol.ADDED_FIELDS) if isinstance(cols.get(k), list)]
         n = min((len(cols[k]) for k in known), default=0)
         for k in known:
             cols[k] = cols[k][:n]
@@ -107,7 +107,8 @@ def columns_agree(doc: Any) -> bool:
     cols = doc.get("landmarks") if isinstance(doc, dict) else None
     if not isinstance(cols, dict):
         return True
-    lengths = {len(cols[k]) for k in protocol.LANDMARK_FIELDS if isinstance(cols.get(k), list)}
+    names = protocol.LANDMARK_FIELDS + protocol.ADDED_FIELDS
+    lengths = {len(cols[k]) for k in names if isinstance(cols.get(k), list)}
     return len(lengths) <= 1
 
 

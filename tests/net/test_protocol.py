@@ -15,7 +15,9 @@ from hypothesis import strategies as st
 from rangebearing.core.types import Landmark
 from rangebearing.errors import ProtocolError, RangeBearingError
 from rangebearing.net.protocol import (
+    ADDED_FIELDS,
     LANDMARK_FIELDS,
+    MTU_PAYLOAD_BYTES,
     Reading,
     RemoteLandmark,
     decode_reading,
@@ -42,23 +44,25 @@ def test_encode_known_values_by_hand() -> None:
 
 def test_heartbeat_has_every_column_empty_and_no_stats() -> None:
     msg = json.loads(encode_reading("zumo", 0, 1.5, []))
-    assert msg["landmarks"] == {name: [] for name in LANDMARK_FIELDS}
+    assert msg["landmarks"] == {name: [] for name in LANDMARK_FIELDS + ADDED_FIELDS}
     assert "fps" not in msg and "dropped" not in msg
     assert decode_reading(encode_reading("zumo", 0, 1.5)) == Reading("zumo", 0, 1.5)
 
 
-def test_ten_landmarks_fit_well_inside_one_mtu() -> None:
-    # Long-winded values on purpose: 4-digit pixels, many decimals, negative signs.
+def test_eight_landmarks_with_every_column_fit_one_mtu() -> None:
+    # Long-winded values on purpose: 4-digit pixels, many decimals, negative signs, 6-digit ids.
+    # Eight is the crowd of issue 8 (5-8 robots in view); more are IP-fragmented (docs/protocol.md).
     lms = [
         Landmark(12.345678, -0.1234567, 12.098765, -1.5432109, 1234.5678,
                  (1279.987654, 959.123456), (1278.55555, 958.44444), 123.456789,
-                 (1200, 900, 79, 59), i % 2 == 0)
-        for i in range(10)
+                 (1200, 900, 79, 59), i % 2 == 0, range_sigma_m=0.123456, bearing_sigma_rad=0.0123456,
+                 visible=0.8765, track_id=123456, range_rate_mps=-1.23456, bearing_rate_radps=-1.234567)
+        for i in range(8)
     ]
     data = encode_reading("zumo-swarm-07", 2**40, 1732419876.123456, lms, fps=29.97,
                           dropped=123456)
-    assert len(decode_reading(data).landmarks) == 10
-    assert len(data) < 1200, len(data)
+    assert len(decode_reading(data).landmarks) == 8
+    assert len(data) <= MTU_PAYLOAD_BYTES, len(data)
 
 
 def test_sender_is_attached_and_not_encoded() -> None:

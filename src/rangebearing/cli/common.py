@@ -94,9 +94,28 @@ def save_config(cfg: Config, path: Union[str, Path], header: str) -> None:
 
 
 def describe(lm: LandmarkLike) -> str:
-    """One landmark, seen here or received, as ``0.412 m  +12.3°`` (noted when outside the envelope)."""
-    note = "" if lm.in_envelope else " (out of envelope)"
-    return f"{lm.range_m:.3f} m  {math.degrees(lm.bearing_rad):+.1f}°{note}"
+    """One landmark, seen here or received: ``#7 0.412 m ±2.3 mm  +12.3° ±0.03°  -0.123 m/s  +31.1°/s``.
+
+    The track id, the sigmas and the rates appear when the landmark carries
+    them (an older sender sends none: ``0.412 m  +12.3°``); partly hidden and
+    out-of-envelope landmarks are noted.
+    """
+    tid = getattr(lm, "track_id", None)
+    rs, bs = getattr(lm, "range_sigma_m", None), getattr(lm, "bearing_sigma_rad", None)
+    rr, br = getattr(lm, "range_rate_mps", None), getattr(lm, "bearing_rate_radps", None)
+    vis = getattr(lm, "visible", None)
+    parts = [f"#{tid} " if tid is not None and tid >= 0 else ""]
+    parts.append(f"{lm.range_m:.3f} m" + (f" ±{1000 * rs:.1f} mm" if rs is not None else ""))
+    parts.append(f"  {math.degrees(lm.bearing_rad):+.1f}°" + (f" ±{math.degrees(bs):.2f}°" if bs is not None else ""))
+    if rr is not None:
+        parts.append(f"  {rr:+.3f} m/s")
+    if br is not None:
+        parts.append(f"  {math.degrees(br):+.1f}°/s")
+    if vis is not None and vis < 0.995:
+        parts.append(f" ({100 * vis:.0f} % visible)")
+    if not lm.in_envelope:
+        parts.append(" (out of envelope)")
+    return "".join(parts)
 
 
 def add_source_args(p: argparse.ArgumentParser) -> None:

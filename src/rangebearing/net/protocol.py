@@ -34,6 +34,10 @@ RAD_DIGITS = 5
 PX_DIGITS = 2
 T_DIGITS = 6
 FPS_DIGITS = 2
+MPS_DIGITS = 3  # rates: 1 mm/s, 1e-4 rad/s
+RADPS_DIGITS = 4
+VISIBLE_DIGITS = 2
+MTU_PAYLOAD_BYTES = 1400  # what one Ethernet/Wi-Fi frame carries without IP fragmentation, with headroom
 
 XY = Tuple[float, float]
 
@@ -41,6 +45,11 @@ XY = Tuple[float, float]
 LANDMARK_FIELDS = (
     "range_m", "bearing_rad", "in_envelope", "l_px", "d_v_m", "d_h_m",
     "red_px", "blue_px", "width_px",
+)
+# Columns added within v1 (uncertainty, occlusion, track identity and rates): a decoder accepts a
+# datagram without them; this encoder writes them whenever the landmarks carry them.
+ADDED_FIELDS = (
+    "range_sigma_m", "bearing_sigma_rad", "visible", "track_id", "range_rate_mps", "bearing_rate_radps",
 )
 READING_FIELDS = ("v", "robot", "seq", "t", "landmarks")  # required
 OPTIONAL_FIELDS = ("fps", "dropped", "omitted")
@@ -68,11 +77,29 @@ class LandmarkLike(Protocol):
     def blue_xy_px(self) -> XY: ...
     @property
     def width_px(self) -> float: ...
+    @property
+    def range_sigma_m(self) -> Optional[float]: ...
+    @property
+    def bearing_sigma_rad(self) -> Optional[float]: ...
+    @property
+    def visible(self) -> Optional[float]: ...
+    @property
+    def track_id(self) -> Optional[int]: ...
+    @property
+    def range_rate_mps(self) -> Optional[float]: ...
+    @property
+    def bearing_rate_radps(self) -> Optional[float]: ...
 
 
 @frozen
 class RemoteLandmark:
-    """One landmark as another robot reported it (same units as ``Landmark``)."""
+    """One landmark as another robot reported it (same units as ``Landmark``).
+
+    The added columns are ``None`` when the sender did not send them (an older
+    sender); ``track_id`` is then ``None`` too, and ``-1`` when the sender
+    processed its frames independently. The rates are also ``None`` while the
+    sender's track is too young to have one.
+    """
 
     range_m: float
     bearing_rad: float
@@ -83,6 +110,12 @@ class RemoteLandmark:
     red_xy_px: XY
     blue_xy_px: XY
     width_px: float
+    range_sigma_m: Optional[float] = None
+    bearing_sigma_rad: Optional[float] = None
+    visible: Optional[float] = None
+    track_id: Optional[int] = None
+    range_rate_mps: Optional[float] = None
+    bearing_rate_radps: Optional[float] = None
 
 
 @frozen
@@ -141,9 +174,55 @@ def _xy(p: Any, what: str) -> List[float]:
     return [_num(x, PX_DIGITS, what), _num(y, PX_DIGITS, what)]
 
 
+def _sigma(x: Any, digits: int, what: str) -> float:
+    """A one-sigma value, rounded up to the wire resolution: never 0 when it is not."""
+    v = _num(x, 12, what, lo=0.0)
+    return max(_num(v, digits, what), 10.0**-digits) if v > 0.0 else 0.0
+
+
+def _track_id(n: Any) -> int:
+    if isinstance(n, bool):
+        raise ProtocolError(f"track_id must be an integer >= -1, got {n!r}")
+    try:
+        i = operator.index(n)
+    except TypeError:
+        raise ProtocolError(f"track_id must be an integer >= -1, got {n!r}") from None
+    if not -1 <= i <= 2**53 - 1:
+        raise ProtocolError(f"track_id must be an integer in [-1, 2**53 - 1], got {n!r}")
+    return i
+
+
+def _rate(x: Any, digits: int, what: str) -> Optional[float]:
+    return None if x is None else _num(x, digits, what)
+
+
+def added_fields(lm: LandmarkLike) -> Dict[str, Any]:
+    """The added columns this landmark carries (see :data:`ADDED_FIELDS`), rounded and checked.
+
+    A group is left out when the landmark lacks it (a :class:`RemoteLandmark`
+    from an older sender): the sigmas together, ``visible``, and ``track_id``
+    with the two rates. A rate of ``None`` (no track history yet) is kept:
+    it goes on the wire as ``null``.
+    """
+    out: Dict[str, Any] = {}
+    rs, bs = getattr(lm, "range_sigma_m", None), getattr(lm, "bearing_sigma_rad", None)
+    if rs is not None and bs is not None:
+        out["range_sigma_m"] = _sigma(rs, M_DIGITS, "range_sigma_m")
+        out["bearing_sigma_rad"] = _sigma(bs, RAD_DIGITS, "bearing_sigma_rad")
+    vis = getattr(lm, "visible", None)
+    if vis is not None:
+        out["visible"] = _num(vis, VISIBLE_DIGITS, "visible", 0.0, 1.0)
+    tid = getattr(lm, "track_id", None)
+    if tid is not None:
+        out["track_id"] = _track_id(tid)
+        out["range_rate_mps"] = _rate(getattr(lm, "range_rate_mps", None), MPS_DIGITS, "range_rate_mps")
+        out["bearing_rate_radps"] = _rate(getattr(lm, "bearing_rate_radps", None), RADPS_DIGITS, "bearing_rate_radps")
+    return out
+
+
 def landmark_fields(lm: LandmarkLike) -> Dict[str, Any]:
     """One landmark's wire fields, rounded and checked: what a datagram carries, and what
-    ``replay --out`` writes per landmark.
+    ``replay --out`` writes per landmark (the added columns included, see :func:`added_fields`).
 
     Raises
     ------
@@ -160,6 +239,7 @@ def landmark_fields(lm: LandmarkLike) -> Dict[str, Any]:
         "red_px": _xy(lm.red_xy_px, "red_px"),
         "blue_px": _xy(lm.blue_xy_px, "blue_px"),
         "width_px": _num(lm.width_px, PX_DIGITS, "width_px", lo=0.0),
+        **added_fields(lm),
     }
 
 
@@ -202,10 +282,10 @@ def encode_reading(
         a NaN or infinite number).
     """
     _text(robot, "robot id")
-    cols: Dict[str, List[Any]] = {name: [] for name in LANDMARK_FIELDS}
-    for lm in landmarks:
-        for name, value in landmark_fields(lm).items():
-            cols[name].append(value)
+    rows = [landmark_fields(lm) for lm in landmarks]
+    # an added column is written only when every landmark has it (always, for this daemon's own)
+    names = LANDMARK_FIELDS + tuple(f for f in ADDED_FIELDS if all(f in r for r in rows))
+    cols: Dict[str, List[Any]] = {name: [r[name] for r in rows] for name in names}
     msg: Dict[str, Any] = {
         "v": PROTOCOL_VERSION,
         "robot": robot,
@@ -302,6 +382,30 @@ _COLUMN_CHECKS: Dict[str, Callable[[Any, str], Any]] = {
 }
 
 
+def _fraction(v: Any, where: str) -> float:
+    return _number(v, where, 0.0, 1.0)
+
+
+def _id(v: Any, where: str) -> int:
+    if _is_number(v) and float(v).is_integer() and -1 <= v <= MAX_INTEGER:  # 7.0 is 7, as for seq
+        return int(v)
+    raise ProtocolError(f"{where}: expected an integer in [-1, 2**53 - 1], got {_show(v)}")
+
+
+def _number_or_null(v: Any, where: str) -> Optional[float]:
+    return None if v is None else _number(v, where)
+
+
+_ADDED_CHECKS: Dict[str, Callable[[Any, str], Any]] = {
+    "range_sigma_m": _size,
+    "bearing_sigma_rad": _size,
+    "visible": _fraction,
+    "track_id": _id,
+    "range_rate_mps": _number_or_null,
+    "bearing_rate_radps": _number_or_null,
+}
+
+
 def _landmarks(cols: Any) -> Tuple[RemoteLandmark, ...]:
     if not isinstance(cols, dict):
         raise ProtocolError(f"landmarks: expected an object of columns, got {type(cols).__name__}")
@@ -310,15 +414,17 @@ def _landmarks(cols: Any) -> Tuple[RemoteLandmark, ...]:
         raise ProtocolError(f"landmarks: missing column(s) {', '.join(missing)}")
     n: Optional[int] = None
     values: Dict[str, List[Any]] = {}
-    for name in LANDMARK_FIELDS:
+    for name in LANDMARK_FIELDS + tuple(f for f in ADDED_FIELDS if f in cols):
         col = cols[name]
         if not isinstance(col, list):
             raise ProtocolError(f"landmarks.{name}: expected an array, got {type(col).__name__}")
         if n is not None and len(col) != n:
             raise ProtocolError(f"landmarks.{name}: {len(col)} entries, other columns have {n}")
         n = len(col)
-        check = _COLUMN_CHECKS[name]
+        check = _COLUMN_CHECKS.get(name) or _ADDED_CHECKS[name]
         values[name] = [check(v, f"landmarks.{name}[{i}]") for i, v in enumerate(col)]
+    absent = [None] * (n or 0)
+    added = {name: values.get(name, absent) for name in ADDED_FIELDS}
     return tuple(
         RemoteLandmark(
             range_m=values["range_m"][i],
@@ -330,6 +436,7 @@ def _landmarks(cols: Any) -> Tuple[RemoteLandmark, ...]:
             red_xy_px=values["red_px"][i],
             blue_xy_px=values["blue_px"][i],
             width_px=values["width_px"][i],
+            **{name: added[name][i] for name in ADDED_FIELDS},
         )
         for i in range(n or 0)
     )
