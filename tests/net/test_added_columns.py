@@ -112,5 +112,5 @@ def test_the_schema_validates_the_added_columns():
 
 def test_a_describe_line_carries_id_sigma_and_rates():
     line = describe(_tracked())
-    assert line.startswith("#7 ") and "±2.3 mm" in line and "-0.123 m/s" in line and "81 % visible" in line
+    assert line.startswith("id 7: ") and "±2.3 mm" in line and "-0.123 m/s" in line and "81 % visible" in line
     assert "°/s" in line

@@ -94,7 +94,7 @@ def save_config(cfg: Config, path: Union[str, Path], header: str) -> None:
 
 
 def describe(lm: LandmarkLike) -> str:
-    """One landmark, seen here or received: ``#7 0.412 m ±2.3 mm  +12.3° ±0.03°  -0.123 m/s  +31.1°/s``.
+    """One landmark, seen here or received: ``id 7: 0.412 m ±2.3 mm  +12.3° ±0.03°  -0.123 m/s  +31.1°/s``.
 
     The track id, the sigmas and the rates appear when the landmark carries
     them (an older sender sends none: ``0.412 m  +12.3°``); partly hidden and
@@ -104,7 +104,7 @@ def describe(lm: LandmarkLike) -> str:
     rs, bs = getattr(lm, "range_sigma_m", None), getattr(lm, "bearing_sigma_rad", None)
     rr, br = getattr(lm, "range_rate_mps", None), getattr(lm, "bearing_rate_radps", None)
     vis = getattr(lm, "visible", None)
-    parts = [f"#{tid} " if tid is not None and tid >= 0 else ""]
+    parts = [f"id {tid}: " if tid is not None and tid >= 0 else ""]
     parts.append(f"{lm.range_m:.3f} m" + (f" ±{1000 * rs:.1f} mm" if rs is not None else ""))
     parts.append(f"  {math.degrees(lm.bearing_rad):+.1f}°" + (f" ±{math.degrees(bs):.2f}°" if bs is not None else ""))
     if rr is not None:

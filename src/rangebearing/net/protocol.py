@@ -187,7 +187,7 @@ def _track_id(n: Any) -> int:
         i = operator.index(n)
     except TypeError:
         raise ProtocolError(f"track_id must be an integer >= -1, got {n!r}") from None
-    if not -1 <= i <= 2**53 - 1:
+    if not -1 <= i <= MAX_INTEGER:
         raise ProtocolError(f"track_id must be an integer in [-1, 2**53 - 1], got {n!r}")
     return i
 
