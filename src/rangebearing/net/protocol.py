@@ -8,25 +8,41 @@ one entry per landmark. Writing each landmark as its own object would repeat
 MTU; column-wise, ten fit in about 1 kB. ``docs/protocol.md`` is the consumer
 documentation; ``schema/reading-v1.json`` is the JSON Schema.
 
-Encoding and decoding are pure functions: no sockets, no clocks.
+Encoding and decoding are pure functions: no sockets, no clocks. The checks
+of single values live in :mod:`rangebearing.net.values`.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import operator
-import sys
 from typing import Any, Callable, Dict, Iterable, List, Optional, Protocol, Tuple
 
 from .._compat import frozen
 from ..errors import ProtocolError
+from .values import (
+    bearing,
+    boolean,
+    encoded,
+    encoded_count,
+    encoded_rate,
+    encoded_sigma,
+    encoded_track_id,
+    fraction,
+    id_number,
+    integer,
+    is_number,
+    number,
+    number_or_null,
+    point,
+    reject_constant,
+    show,
+    size,
+    text,
+)
 
 PROTOCOL_VERSION = 1
 MAX_DATAGRAM_BYTES = 65507  # the largest UDP payload over IPv4
-# The decoder's limits are the schema's: a finite IEEE double, and integers a double holds exactly.
-MAX_FINITE = sys.float_info.max
-MAX_INTEGER = 2**53 - 1
 
 # Rounding on the wire: 0.1 mm, 1e-5 rad (0.0006 degrees), 0.01 px, 1 µs.
 M_DIGITS = 4
@@ -147,53 +163,9 @@ class Reading:
 # --- encoding ---------------------------------------------------------------
 
 
-def _num(x: Any, digits: int, what: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-    try:
-        v = float(x)
-    except (TypeError, ValueError, OverflowError):
-        raise ProtocolError(f"cannot encode {what}={_show(x)}: not a number") from None
-    if not math.isfinite(v):
-        raise ProtocolError(f"cannot encode {what}={v!r}: not a finite number")
-    if not lo <= v <= hi:  # the limits decode_reading enforces: never send what a consumer must drop
-        raise ProtocolError(f"cannot encode {what}={v!r}: outside [{lo:g}, {hi:g}]")
-    return round(v, digits) + 0.0  # + 0.0 turns -0.0 into 0.0
-
-
-def _count(n: Any, what: str) -> int:
-    try:
-        i = operator.index(n)
-    except TypeError:
-        raise ProtocolError(f"{what} must be an integer >= 0, got {n!r}") from None
-    if isinstance(n, bool) or not 0 <= i <= MAX_INTEGER:
-        raise ProtocolError(f"{what} must be an integer in [0, 2**53 - 1], got {n!r}")
-    return i
-
-
 def _xy(p: Any, what: str) -> List[float]:
     x, y = p
-    return [_num(x, PX_DIGITS, what), _num(y, PX_DIGITS, what)]
-
-
-def _sigma(x: Any, digits: int, what: str) -> float:
-    """A one-sigma value, rounded up to the wire resolution: never 0 when it is not."""
-    v = _num(x, 12, what, lo=0.0)
-    return max(_num(v, digits, what), 10.0**-digits) if v > 0.0 else 0.0
-
-
-def _track_id(n: Any) -> int:
-    if isinstance(n, bool):
-        raise ProtocolError(f"track_id must be an integer >= -1, got {n!r}")
-    try:
-        i = operator.index(n)
-    except TypeError:
-        raise ProtocolError(f"track_id must be an integer >= -1, got {n!r}") from None
-    if not -1 <= i <= MAX_INTEGER:
-        raise ProtocolError(f"track_id must be an integer in [-1, 2**53 - 1], got {n!r}")
-    return i
-
-
-def _rate(x: Any, digits: int, what: str) -> Optional[float]:
-    return None if x is None else _num(x, digits, what)
+    return [encoded(x, PX_DIGITS, what), encoded(y, PX_DIGITS, what)]
 
 
 def added_fields(lm: LandmarkLike) -> Dict[str, Any]:
@@ -207,16 +179,17 @@ def added_fields(lm: LandmarkLike) -> Dict[str, Any]:
     out: Dict[str, Any] = {}
     rs, bs = getattr(lm, "range_sigma_m", None), getattr(lm, "bearing_sigma_rad", None)
     if rs is not None and bs is not None:
-        out["range_sigma_m"] = _sigma(rs, M_DIGITS, "range_sigma_m")
-        out["bearing_sigma_rad"] = _sigma(bs, RAD_DIGITS, "bearing_sigma_rad")
+        out["range_sigma_m"] = encoded_sigma(rs, M_DIGITS, "range_sigma_m")
+        out["bearing_sigma_rad"] = encoded_sigma(bs, RAD_DIGITS, "bearing_sigma_rad")
     vis = getattr(lm, "visible", None)
     if vis is not None:
-        out["visible"] = _num(vis, VISIBLE_DIGITS, "visible", 0.0, 1.0)
+        out["visible"] = encoded(vis, VISIBLE_DIGITS, "visible", 0.0, 1.0)
     tid = getattr(lm, "track_id", None)
     if tid is not None:
-        out["track_id"] = _track_id(tid)
-        out["range_rate_mps"] = _rate(getattr(lm, "range_rate_mps", None), MPS_DIGITS, "range_rate_mps")
-        out["bearing_rate_radps"] = _rate(getattr(lm, "bearing_rate_radps", None), RADPS_DIGITS, "bearing_rate_radps")
+        out["track_id"] = encoded_track_id(tid)
+        out["range_rate_mps"] = encoded_rate(getattr(lm, "range_rate_mps", None), MPS_DIGITS, "range_rate_mps")
+        br = getattr(lm, "bearing_rate_radps", None)
+        out["bearing_rate_radps"] = encoded_rate(br, RADPS_DIGITS, "bearing_rate_radps")
     return out
 
 
@@ -230,15 +203,15 @@ def landmark_fields(lm: LandmarkLike) -> Dict[str, Any]:
         A value is not finite or is outside what :func:`decode_reading` accepts.
     """
     return {
-        "range_m": _num(lm.range_m, M_DIGITS, "range_m", lo=0.0),
-        "bearing_rad": _num(lm.bearing_rad, RAD_DIGITS, "bearing_rad", -math.pi, math.pi),
+        "range_m": encoded(lm.range_m, M_DIGITS, "range_m", lo=0.0),
+        "bearing_rad": encoded(lm.bearing_rad, RAD_DIGITS, "bearing_rad", -math.pi, math.pi),
         "in_envelope": bool(lm.in_envelope),
-        "l_px": _num(lm.l_px, PX_DIGITS, "l_px", lo=0.0),
-        "d_v_m": _num(lm.d_v_m, M_DIGITS, "d_v_m"),
-        "d_h_m": _num(lm.d_h_m, M_DIGITS, "d_h_m"),
+        "l_px": encoded(lm.l_px, PX_DIGITS, "l_px", lo=0.0),
+        "d_v_m": encoded(lm.d_v_m, M_DIGITS, "d_v_m"),
+        "d_h_m": encoded(lm.d_h_m, M_DIGITS, "d_h_m"),
         "red_px": _xy(lm.red_xy_px, "red_px"),
         "blue_px": _xy(lm.blue_xy_px, "blue_px"),
-        "width_px": _num(lm.width_px, PX_DIGITS, "width_px", lo=0.0),
+        "width_px": encoded(lm.width_px, PX_DIGITS, "width_px", lo=0.0),
         **added_fields(lm),
     }
 
@@ -281,7 +254,7 @@ def encode_reading(
         An argument cannot be represented (empty robot id, negative seq,
         a NaN or infinite number).
     """
-    _text(robot, "robot id")
+    text(robot, "robot id")
     rows = [landmark_fields(lm) for lm in landmarks]
     # an added column is written only when every landmark has it (always, for this daemon's own)
     names = LANDMARK_FIELDS + tuple(f for f in ADDED_FIELDS if all(f in r for r in rows))
@@ -289,120 +262,42 @@ def encode_reading(
     msg: Dict[str, Any] = {
         "v": PROTOCOL_VERSION,
         "robot": robot,
-        "seq": _count(seq, "seq"),
-        "t": _num(t, T_DIGITS, "t"),
+        "seq": encoded_count(seq, "seq"),
+        "t": encoded(t, T_DIGITS, "t"),
         "landmarks": cols,
     }
     if fps is not None:
-        msg["fps"] = _num(fps, FPS_DIGITS, "fps")
+        msg["fps"] = encoded(fps, FPS_DIGITS, "fps")
     if dropped is not None:
-        msg["dropped"] = _count(dropped, "dropped")
+        msg["dropped"] = encoded_count(dropped, "dropped")
     if omitted is not None:
-        msg["omitted"] = _count(omitted, "omitted")
+        msg["omitted"] = encoded_count(omitted, "omitted")
     return json.dumps(msg, separators=(",", ":"), allow_nan=False).encode("ascii")
 
 
 # --- decoding ---------------------------------------------------------------
 
 
-def _reject_constant(name: str) -> Any:
-    raise ProtocolError(f"{name} is not allowed in a reading")
-
-
-def _show(v: Any, limit: int = 40) -> str:
-    """``repr(v)`` cut to ``limit`` characters: a hostile value never floods a message."""
-    if isinstance(v, (dict, list)):
-        return f"{type(v).__name__} of {len(v)}"
-    text = repr(v) if not isinstance(v, int) or abs(v) < 10**limit else f"an integer of {len(str(abs(v)))} digits"
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _is_number(v: Any) -> bool:
-    """A JSON number that fits a finite double (ints compared exactly: 10**309 is not)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        return False
-    return -MAX_FINITE <= v <= MAX_FINITE  # False for NaN, inf and out-of-range ints
-
-
-def _number(v: Any, where: str, lo: float = -math.inf, hi: float = math.inf) -> float:
-    if not _is_number(v) or not lo <= v <= hi:
-        bound = "" if lo == -math.inf else f" >= {lo:g}"
-        bound += "" if hi == math.inf else f" <= {hi:g}"
-        raise ProtocolError(f"{where}: expected a finite number{bound}, got {_show(v)}")
-    return float(v)
-
-
-def _integer(v: Any, where: str) -> int:
-    # JSON does not tell 5 from 5.0 (nor does the JSON Schema): both are the integer 5.
-    if _is_number(v) and float(v).is_integer() and 0 <= v <= MAX_INTEGER:
-        return int(v)
-    raise ProtocolError(f"{where}: expected an integer in [0, 2**53 - 1], got {_show(v)}")
-
-
-def _boolean(v: Any, where: str) -> bool:
-    if not isinstance(v, bool):
-        raise ProtocolError(f"{where}: expected true or false, got {_show(v)}")
-    return v
-
-
-def _text(v: Any, where: str) -> str:
-    if not isinstance(v, str) or not v:
-        raise ProtocolError(f"{where}: expected a non-empty string, got {_show(v)}")
-    try:
-        v.encode("utf-8")
-    except UnicodeEncodeError:  # a lone surrogate ("\\ud800"): no consumer could print or store it
-        raise ProtocolError(f"{where}: not valid Unicode text (lone surrogate)") from None
-    return v
-
-
-def _point(v: Any, where: str) -> XY:
-    if not isinstance(v, list) or len(v) != 2:
-        raise ProtocolError(f"{where}: expected [x, y], got {_show(v)}")
-    return (_number(v[0], where), _number(v[1], where))
-
-
-def _bearing(v: Any, where: str) -> float:
-    return _number(v, where, -math.pi, math.pi)
-
-
-def _size(v: Any, where: str) -> float:
-    return _number(v, where, 0.0)
-
-
 _COLUMN_CHECKS: Dict[str, Callable[[Any, str], Any]] = {
-    "range_m": _size,
-    "bearing_rad": _bearing,
-    "in_envelope": _boolean,
-    "l_px": _size,
-    "d_v_m": _number,
-    "d_h_m": _number,
-    "red_px": _point,
-    "blue_px": _point,
-    "width_px": _size,
+    "range_m": size,
+    "bearing_rad": bearing,
+    "in_envelope": boolean,
+    "l_px": size,
+    "d_v_m": number,
+    "d_h_m": number,
+    "red_px": point,
+    "blue_px": point,
+    "width_px": size,
 }
 
 
-def _fraction(v: Any, where: str) -> float:
-    return _number(v, where, 0.0, 1.0)
-
-
-def _id(v: Any, where: str) -> int:
-    if _is_number(v) and float(v).is_integer() and -1 <= v <= MAX_INTEGER:  # 7.0 is 7, as for seq
-        return int(v)
-    raise ProtocolError(f"{where}: expected an integer in [-1, 2**53 - 1], got {_show(v)}")
-
-
-def _number_or_null(v: Any, where: str) -> Optional[float]:
-    return None if v is None else _number(v, where)
-
-
 _ADDED_CHECKS: Dict[str, Callable[[Any, str], Any]] = {
-    "range_sigma_m": _size,
-    "bearing_sigma_rad": _size,
-    "visible": _fraction,
-    "track_id": _id,
-    "range_rate_mps": _number_or_null,
-    "bearing_rate_radps": _number_or_null,
+    "range_sigma_m": size,
+    "bearing_sigma_rad": size,
+    "visible": fraction,
+    "track_id": id_number,
+    "range_rate_mps": number_or_null,
+    "bearing_rate_radps": number_or_null,
 }
 
 
@@ -460,7 +355,7 @@ def decode_reading(data: bytes, sender: Optional[Tuple[str, int]] = None) -> Rea
     if len(data) > MAX_DATAGRAM_BYTES:
         raise ProtocolError(f"datagram of {len(data)} bytes is larger than any UDP payload")
     try:
-        msg = json.loads(bytes(data).decode("utf-8"), parse_constant=_reject_constant)
+        msg = json.loads(bytes(data).decode("utf-8"), parse_constant=reject_constant)
     except UnicodeDecodeError:
         raise ProtocolError("datagram is not UTF-8 text") from None
     except ProtocolError:
@@ -479,18 +374,18 @@ def _reading(msg: Any, sender: Optional[Tuple[str, int]]) -> Reading:
     if not isinstance(msg, dict) or "v" not in msg:
         raise ProtocolError("not a rangebearing reading (no \"v\" field)")
     v = msg["v"]
-    if not _is_number(v) or v != PROTOCOL_VERSION:
-        raise ProtocolError(f"unsupported protocol version {_show(v)} (this reader speaks v1)")
+    if not is_number(v) or v != PROTOCOL_VERSION:
+        raise ProtocolError(f"unsupported protocol version {show(v)} (this reader speaks v1)")
     missing = [name for name in READING_FIELDS if name not in msg]
     if missing:
         raise ProtocolError(f"missing field(s) {', '.join(missing)}")
     return Reading(
-        robot=_text(msg["robot"], "robot"),
-        seq=_integer(msg["seq"], "seq"),
-        t=_number(msg["t"], "t"),
+        robot=text(msg["robot"], "robot"),
+        seq=integer(msg["seq"], "seq"),
+        t=number(msg["t"], "t"),
         landmarks=_landmarks(msg["landmarks"]),
-        fps=_number(msg["fps"], "fps", 0.0) if "fps" in msg else None,
-        dropped=_integer(msg["dropped"], "dropped") if "dropped" in msg else None,
+        fps=number(msg["fps"], "fps", 0.0) if "fps" in msg else None,
+        dropped=integer(msg["dropped"], "dropped") if "dropped" in msg else None,
         sender=sender,
-        omitted=_integer(msg["omitted"], "omitted") if "omitted" in msg else None,
+        omitted=integer(msg["omitted"], "omitted") if "omitted" in msg else None,
     )
