@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 
 from rangebearing.core.types import Landmark
 from rangebearing.errors import ProtocolError, RangeBearingError
+from rangebearing.net.fit import MTU_PAYLOAD_BYTES
 from rangebearing.net.protocol import (
     ADDED_FIELDS,
     LANDMARK_FIELDS,
-    MTU_PAYLOAD_BYTES,
     Reading,
     RemoteLandmark,
     decode_reading,

@@ -53,7 +53,6 @@ FPS_DIGITS = 2
 MPS_DIGITS = 3  # rates: 1 mm/s, 1e-4 rad/s
 RADPS_DIGITS = 4
 VISIBLE_DIGITS = 2
-MTU_PAYLOAD_BYTES = 1400  # what one Ethernet/Wi-Fi frame carries without IP fragmentation, with headroom
 
 XY = Tuple[float, float]
 
