@@ -1,62 +1,122 @@
 """Per-key checks for the config loader.
 
 A check takes the raw YAML value and returns the normalised value, or raises
-ValueError with a short reason that the loader prefixes with the key.
+ValueError with a short reason that the loader prefixes with the key; a check
+of a list raises :class:`Invalid` naming every bad entry (``[2]: ...``). Values
+are shown cut (:func:`show`): a message never carries a whole hostile value.
 """
 
 from __future__ import annotations
 
 import ipaddress
 import math
-from typing import Any, Callable, Mapping, Tuple
+import re
+from typing import Any, Callable, Dict, List, Mapping, Tuple
 
 Check = Callable[[Any], Any]
 
+MAX_DESTINATIONS = 32  # unicast destinations: one socket each
+ROBOT_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
+_LABEL = r"[A-Za-z0-9_]([A-Za-z0-9_-]{0,61}[A-Za-z0-9_])?"
+HOSTNAME = re.compile(rf"(?=.{{1,253}}$){_LABEL}(\.{_LABEL})*\.?")
+PORT = re.compile(r"[0-9]{1,5}")
 
-def number(lo: float = -math.inf, hi: float = math.inf, integer: bool = False) -> Check:
+
+class Invalid(ValueError):
+    """Problems in entries of one value: ``(where, message)`` pairs, ``where`` like ``"[2]"``."""
+
+    def __init__(self, problems: List[Tuple[str, str]]) -> None:
+        self.problems = problems
+        super().__init__("; ".join(f"{w}: {m}" for w, m in problems))
+
+
+def show(v: Any, limit: int = 40) -> str:
+    """A value as a message shows it: YAML spelling for booleans and null, cut to ``limit``."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "null (nothing)"
+    if isinstance(v, (list, tuple)):
+        return f"a list of {len(v)}" if len(v) > 4 else _cut(repr(list(v)), limit)
+    if isinstance(v, Mapping):
+        return f"a mapping of {len(v)} key{'s' if len(v) != 1 else ''}"
+    if isinstance(v, int) and abs(v) >= 10**limit:
+        return f"an integer of {len(str(abs(v)))} digits"
+    return _cut(repr(v), limit)
+
+
+def _cut(text: str, limit: int) -> str:
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _fmt(x: float) -> str:
+    return f"{x:g}"
+
+
+def number(lo: float = -math.inf, hi: float = math.inf, integer: bool = False, above: float = -math.inf) -> Check:
+    """A number in ``[lo, hi]`` (and ``> above``); the message says exactly what is allowed."""
+    kind = "an integer" if integer else "a number"
+    if above > -math.inf:
+        allowed = f"{kind} > {_fmt(above)}" + (f" and <= {_fmt(hi)}" if hi < math.inf else "")
+    elif lo > -math.inf and hi < math.inf:
+        allowed = f"{kind} from {_fmt(lo)} to {_fmt(hi)}"
+    elif lo > -math.inf:
+        allowed = f"{kind} >= {_fmt(lo)}"
+    else:
+        allowed = kind if hi == math.inf else f"{kind} <= {_fmt(hi)}"
+
     def check(v: Any) -> Any:
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            raise ValueError(f"expected a number, got {v!r}")
-        if integer and not float(v).is_integer():
-            raise ValueError(f"expected an integer, got {v!r}")
-        if not math.isfinite(v) or not lo <= v <= hi:
-            raise ValueError(f"{v!r} is outside [{lo}, {hi}]")
+        ok = not isinstance(v, bool) and isinstance(v, (int, float))
+        # ints are compared exactly: 10**400 is not a float and never becomes one
+        ok = ok and -1.8e308 < v < 1.8e308 and not (isinstance(v, float) and math.isnan(v))
+        ok = ok and (not integer or float(v).is_integer()) and lo <= v <= hi and v > above
+        if not ok:
+            raise ValueError(f"must be {allowed}, got {show(v)}")
         return int(v) if integer else float(v)
 
     return check
 
 
 def positive(integer: bool = False) -> Check:
-    inner = number(0, math.inf, integer)
-
-    def check(v: Any) -> Any:
-        out = inner(v)
-        if out <= 0:
-            raise ValueError(f"must be > 0, got {v!r}")
-        return out
-
-    return check
+    return number(integer=integer, above=0)
 
 
 def boolean(v: Any) -> bool:
     if not isinstance(v, bool):
-        raise ValueError(f"expected true or false, got {v!r}")
+        raise ValueError(f"expected true or false, got {show(v)}")
     return v
 
 
 def choice(*choices: str) -> Check:
     def check(v: Any) -> str:
-        if v not in choices:
-            raise ValueError(f"{v!r} is not one of {', '.join(choices)}")
-        return str(v)
+        if isinstance(v, bool):  # off/on/yes/no unquoted are YAML booleans
+            raise ValueError(f"got the YAML boolean {show(v)} (unquoted on/off/yes/no are booleans); "
+                             f"expected one of: {', '.join(choices)}")
+        if not isinstance(v, str) or v not in choices:
+            raise ValueError(f"expected one of: {', '.join(choices)}; got {show(v)}")
+        return v
 
     return check
 
 
 def string(v: Any) -> str:
+    """Text without control characters (an integer is taken as its digits, e.g. ``device: 0``)."""
     if isinstance(v, bool) or not isinstance(v, (str, int)):
-        raise ValueError(f"expected a string, got {v!r}")
-    return str(v)
+        raise ValueError(f"expected a string, got {show(v)}")
+    text = str(v)
+    bad = next((c for c in text if not c.isprintable() or "\ud800" <= c <= "\udfff"), None)
+    if bad is not None:
+        raise ValueError(f"contains the control character {bad!r} (in {show(text)})")
+    if len(text) > 4096:
+        raise ValueError(f"is {len(text)} characters long; at most 4096")
+    return text
+
+
+def robot_id(v: Any) -> str:
+    if not isinstance(v, str) or not ROBOT_ID.fullmatch(v):
+        raise ValueError("must be 1-64 letters, digits, '.', '_' or '-', starting with a letter or digit "
+                         f"(it names the robot in every datagram); got {show(v)}")
+    return v
 
 
 def odd_ksize(v: Any) -> int:
@@ -71,7 +131,7 @@ def pair(lo: float, hi: float, integer: bool = False, ordered: bool = True) -> C
 
     def check(v: Any) -> Tuple[Any, Any]:
         if not isinstance(v, (list, tuple)) or len(v) != 2:
-            raise ValueError(f"expected a pair [low, high], got {v!r}")
+            raise ValueError(f"expected a pair [low, high], got {show(v)}")
         a, b = num(v[0]), num(v[1])
         if ordered and a > b:
             raise ValueError(f"low {a} is above high {b}")
@@ -80,45 +140,96 @@ def pair(lo: float, hi: float, integer: bool = False, ordered: bool = True) -> C
     return check
 
 
+def _entries(v: Any, check: Check, what: str, max_len: int = 64) -> Tuple[Any, ...]:
+    """Check every entry of a list; report every bad one, not the first."""
+    if not isinstance(v, (list, tuple)):
+        raise ValueError(f"expected a list of {what}, got {show(v)}")
+    if len(v) > max_len:
+        raise ValueError(f"{len(v)} entries; at most {max_len}")
+    out, problems = [], []
+    for i, entry in enumerate(v):
+        try:
+            out.append(check(entry))
+        except ValueError as exc:
+            problems.append((f"[{i}]", str(exc)))
+    if problems:
+        raise Invalid(problems)
+    return tuple(out)
+
+
 def hue_ranges(v: Any) -> Tuple[Tuple[int, int], ...]:
-    if isinstance(v, (list, tuple)) and len(v) == 2 and all(isinstance(x, int) for x in v):
-        v = [v]
-    if not isinstance(v, (list, tuple)) or not v:
-        raise ValueError(f"expected a list of [low, high] hue ranges (0-179), got {v!r}")
-    return tuple(pair(0, 179, integer=True)(r) for r in v)
+    what = "[low, high] hue ranges (0-179), e.g. [[0, 10], [165, 179]]"
+    if isinstance(v, (list, tuple)) and v and not any(isinstance(x, (list, tuple)) for x in v):
+        raise ValueError(f"expected a list of {what}; a flat {show(v)} is not (write [{show(list(v))}])")
+    if isinstance(v, (list, tuple)) and not v:
+        raise ValueError(f"expected at least one of {what}")
+    return _entries(v, pair(0, 179, integer=True), what, max_len=8)
 
 
 def distortion(v: Any) -> Tuple[float, ...]:
     if not isinstance(v, (list, tuple)) or len(v) not in (4, 5, 8):
-        raise ValueError(f"expected 4, 5 or 8 OpenCV coefficients, got {v!r}")
-    return tuple(number()(c) for c in v)
+        raise ValueError(f"expected 4, 5 or 8 OpenCV coefficients, got {show(v)}")
+    return _entries(v, number(-1e6, 1e6), "coefficients")
+
+
+def _host(text: str) -> str:
+    host = text[1:-1] if text.startswith("[") and text.endswith("]") else text
+    try:
+        return str(ipaddress.ip_address(host))
+    except ValueError:
+        pass
+    if not host.isascii() or not HOSTNAME.fullmatch(host) or host.replace(".", "").isdigit():
+        raise ValueError(f"{show(host)} is not an IP address or a host name")
+    return host
 
 
 def host_port(v: Any) -> Tuple[str, int]:
-    if isinstance(v, str) and v.rpartition(":")[0]:
-        host, _, port = v.rpartition(":")
-        return (host.strip("[]"), number(1, 65535, integer=True)(int(port) if port.isdigit() else port))
-    raise ValueError(f"expected 'host:port', got {v!r}")
+    if not isinstance(v, str) or not v.rpartition(":")[0]:
+        raise ValueError(f"expected 'host:port', got {show(v)}")
+    host, _, port = v.rpartition(":")
+    if not PORT.fullmatch(port) or not 1 <= int(port) <= 65535:
+        raise ValueError(f"port {show(port)} is not a number from 1 to 65535 (in {show(v)})")
+    return (_host(host), int(port))
 
 
 def destinations(v: Any) -> Tuple[Tuple[str, int], ...]:
-    if not isinstance(v, (list, tuple)):
-        raise ValueError(f"expected a list of 'host:port', got {v!r}")
-    return tuple(host_port(d) for d in v)
+    dests = _entries(v, host_port, "'host:port' strings", max_len=MAX_DESTINATIONS)
+    first: Dict[Tuple[str, int], int] = {}
+    problems = []
+    for i, (host, port) in enumerate(dests):
+        key = (host.lower().rstrip("."), port)
+        if key in first:
+            problems.append((f"[{i}]", f"same destination as [{first[key]}] ({host}:{port})"))
+        first.setdefault(key, i)
+    if problems:
+        raise Invalid(problems)
+    return dests
+
+
+def multicast_group(v: Any) -> str:
+    text = string(v)
+    if text and not is_ipv4_multicast(text):
+        raise ValueError(f"{show(text)} is not an IPv4 multicast address (224.0.0.0 to 239.255.255.255)")
+    return text
 
 
 def controls(v: Any) -> Tuple[Tuple[str, Any], ...]:
     if v is None:
         return ()
     if not isinstance(v, Mapping):
-        raise ValueError(f"expected a mapping of Picamera2 control names to values, got {v!r}")
-    out = []
+        raise ValueError(f"expected a mapping of Picamera2 control names to values, got {show(v)}")
+    out, problems = [], []
     for key, val in v.items():
-        if not isinstance(key, str) or not key[:1].isupper():
-            raise ValueError(f"control name {key!r} should be a libcamera control such as AeEnable")
-        if isinstance(val, list):
-            val = tuple(val)
-        out.append((key, val))
+        if not isinstance(key, str) or not key[:1].isupper() or not key.isalnum():
+            problems.append((f"[{show(key)}]", "should be a libcamera control name such as AeEnable"))
+            continue
+        items = val if isinstance(val, list) else [val]
+        if len(items) > 16 or not all(isinstance(x, (bool, int, float)) for x in items):
+            problems.append((f".{key}", f"expected a number, true/false or a short list of numbers, got {show(val)}"))
+            continue
+        out.append((key, tuple(val) if isinstance(val, list) else val))
+    if problems:
+        raise Invalid(problems)
     return tuple(out)
 
 

@@ -1,8 +1,10 @@
 """Configuration: YAML in, one validated frozen dataclass tree out, and back to YAML.
 
-``yaml.safe_load`` → per-key checks → normalised values → cross-field checks.
-Every problem is gathered and raised together in a single :class:`ConfigError`
-that names the file and the key, so a user fixes a file in one pass.
+A bounded safe YAML read (:mod:`.yaml_safe`) → per-key checks → normalised
+values → cross-field checks (including what a deployment can reach: a datagram
+that fits one packet, a capture budget inside the watchdog). Every problem is
+gathered and raised together in a single :class:`ConfigError` that names the
+file and the key, so a user fixes a file in one pass; nothing else escapes.
 """
 
 from __future__ import annotations
@@ -15,7 +17,8 @@ import yaml
 
 from ..errors import ConfigError
 from . import checks as ck
-from .schema import SCHEMA, Config
+from .schema import MAX_CAPTURE_BUDGET_S, SCHEMA, Config
+from .yaml_safe import load_yaml
 
 
 def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Config] = None) -> Config:
@@ -29,7 +32,7 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
     sections: Dict[str, Any] = {}
     for name in data:
         if name not in SCHEMA:
-            problems.append(f"unknown section {name!r} (known: {', '.join(SCHEMA)})")
+            problems.append(f"unknown section {ck.show(name)} (known: {', '.join(SCHEMA)})")
     for name, (_cls, checks) in SCHEMA.items():
         current = getattr(base, name)
         raw = data.get(name)
@@ -37,16 +40,18 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
             sections[name] = current
             continue
         if not isinstance(raw, Mapping):
-            problems.append(f"{name}: must be a mapping, got {raw!r}")
+            problems.append(f"{name}: must be a mapping, got {ck.show(raw)}")
             sections[name] = current
             continue
         values: Dict[str, Any] = {}
         for key, val in raw.items():
             if key not in checks:
-                problems.append(f"{name}.{key}: unknown key (known: {', '.join(checks)})")
+                problems.append(f"{name}.{_key(key)}: unknown key (known: {', '.join(checks)})")
                 continue
             try:
                 values[key] = checks[key](val)
+            except ck.Invalid as exc:  # every bad entry of a list, each named
+                problems.extend(f"{name}.{key}{where}: {msg}" for where, msg in exc.problems)
             except (ValueError, TypeError) as exc:
                 problems.append(f"{name}.{key}: {exc}")
         sections[name] = dataclasses.replace(current, **values)
@@ -55,6 +60,11 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
     if problems:
         raise ConfigError(problems, source)
     return cfg
+
+
+def _key(key: Any) -> str:
+    """A YAML key as a message shows it: plain when it is short text, else cut and quoted."""
+    return key if isinstance(key, str) and key.isprintable() and len(key) <= 40 else ck.show(key)
 
 
 def check(cfg: Config) -> None:
@@ -82,8 +92,28 @@ def _cross_checks(cfg: Config) -> list[str]:
     if cfg.source.kind in ("recorded",) and not cfg.source.path:
         p.append("source.path: required when source.kind is 'recorded'")
     if cfg.publish.multicast_group and not ck.is_ipv4_multicast(cfg.publish.multicast_group):
-        p.append(f"publish.multicast_group: {cfg.publish.multicast_group!r} is not an IPv4 multicast address")
+        p.append(f"publish.multicast_group: {ck.show(cfg.publish.multicast_group)} is not an IPv4 multicast address")
+    src = cfg.source
+    budget_s = src.timeout_s * src.retries
+    if budget_s > MAX_CAPTURE_BUDGET_S:
+        p.append(f"source.timeout_s × source.retries: {budget_s:g} s without a frame before the daemon gives up; "
+                 f"at most {MAX_CAPTURE_BUDGET_S:g} s, clearly inside the service's WatchdogSec=20s")
+    p.extend(_datagram_fits(cfg))
     return p
+
+
+def _datagram_fits(cfg: Config) -> list[str]:
+    """A frame with ``max_landmarks`` landmarks must fit one packet (else fewer are sent, flagged)."""
+    from ..net.fit import MTU_PAYLOAD_BYTES, landmarks_that_fit, worst_case_bytes  # net imports config
+
+    n, robot = cfg.detection.max_landmarks, cfg.publish.robot_id
+    size = worst_case_bytes(robot, n, cfg.camera.width_px, cfg.camera.height_px)
+    if size <= MTU_PAYLOAD_BYTES:
+        return []
+    fit = landmarks_that_fit(robot, cfg.camera.width_px, cfg.camera.height_px)
+    return [f"detection.max_landmarks: {n} landmarks make datagrams of up to {size:,} bytes, over the "
+            f"{MTU_PAYLOAD_BYTES:,}-byte limit of one unfragmented packet; at most {fit} fit"
+            + (f" with robot_id {robot!r}" if len(robot) > 8 else "")]
 
 
 def load_config(path: Union[str, Path, None] = None) -> Config:
@@ -97,19 +127,20 @@ def load_config(path: Union[str, Path, None] = None) -> Config:
     """
     if path is None:
         return Config()
-    source = str(path)
+    source = ck.show(str(path), 200)[1:-1]
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError([f"cannot read file: {exc.strerror or exc}"], source) from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ConfigError([f"not valid YAML: {exc}".replace("\n", " ")], source) from None
-    cfg = config_from_mapping(data, source)
-    if cfg.source.path and not Path(cfg.source.path).is_absolute():  # relative to the file, not the cwd
-        resolved = str((Path(path).parent / cfg.source.path).resolve())
-        cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, path=resolved))
+        cfg = config_from_mapping(load_yaml(path), source)
+        if cfg.source.path and not Path(cfg.source.path).is_absolute():  # relative to the file, not the cwd
+            resolved = str((Path(path).parent / cfg.source.path).resolve())
+            cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, path=resolved))
+    except ConfigError:
+        raise
+    # The checks above are meant to catch everything; a case they miss is still a problem
+    # of this file, never a traceback (at start-up) or a dead daemon (on SIGHUP).
+    except (ValueError, TypeError, KeyError, AttributeError, OverflowError, RecursionError, OSError,
+            RuntimeError) as exc:
+        raise ConfigError([f"cannot use this file: {type(exc).__name__}: {ck.show(str(exc), 200)[1:-1]}"],
+                          source) from None
     return cfg
 
 

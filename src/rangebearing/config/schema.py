@@ -17,6 +17,9 @@ from . import checks as ck
 
 DEFAULT_PORT = 47800
 SOURCES = ("recorded", "opencv", "picamera2", "synthetic")
+# No frame for timeout_s × retries seconds: the daemon reopens the camera halfway, then exits
+# cleanly for systemd to restart it, always before the unit's WatchdogSec=20s would SIGABRT it.
+MAX_CAPTURE_BUDGET_S = 12.0
 
 
 @frozen
@@ -143,21 +146,21 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "hflip": ck.boolean,
             "vflip": ck.boolean,
             "buffer_count": ck.number(1, 16, integer=True),
-            "timeout_s": ck.positive(),
-            "retries": ck.number(0, 1000, integer=True),
+            "timeout_s": ck.number(above=0, hi=4),
+            "retries": ck.number(1, 100, integer=True),
             "controls": ck.controls,
         },
     ),
     "publish": (
         PublishConfig,
         {
-            "robot_id": ck.string,
+            "robot_id": ck.robot_id,
             "unicast": ck.destinations,
-            "multicast_group": ck.string,
+            "multicast_group": ck.multicast_group,
             "multicast_port": ck.number(1, 65535, integer=True),
             "multicast_ttl": ck.number(0, 255, integer=True),
             "multicast_interface": ck.string,
         },
     ),
-    "daemon": (DaemonConfig, {"status_interval_s": ck.positive(), "echo": ck.boolean}),
+    "daemon": (DaemonConfig, {"status_interval_s": ck.number(above=0, hi=3600), "echo": ck.boolean}),
 }

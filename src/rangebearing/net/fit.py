@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from typing import Iterable, Optional, Sequence
 
+from ..core.types import Landmark
 from .protocol import LandmarkLike, encode_reading
 
 MTU_PAYLOAD_BYTES = 1400  # one Ethernet/Wi-Fi frame without IP fragmentation, with headroom for headers
@@ -50,3 +51,32 @@ def encode_fitting(
         else:
             hi = mid - 1
     return encode_reading(robot, seq, t, nearest[:lo], fps, dropped, omitted=len(lms) - lo)
+
+
+def _worst_landmark(width_px: int, height_px: int) -> Landmark:
+    """A landmark whose every field takes as many characters on the wire as a real one can."""
+    edge = float(max(width_px, height_px)) - 0.01  # a centroid at the far edge: most digits
+    return Landmark(
+        range_m=99.9999, bearing_rad=-3.14159, d_v_m=-99.9999, d_h_m=-99.9999, l_px=edge,
+        red_xy_px=(edge, edge), blue_xy_px=(edge, edge), width_px=edge, bbox_px=(0, 0, 1, 1),
+        in_envelope=False, range_sigma_m=99.9999, bearing_sigma_rad=3.14159, visible=0.99,
+        track_id=2**31 - 1, range_rate_mps=-99.999, bearing_rate_radps=-9.9999,
+    )
+
+
+def worst_case_bytes(robot: str, n_landmarks: int, width_px: int = 640, height_px: int = 480) -> int:
+    """The largest datagram ``n_landmarks`` landmarks can make (every column, every digit, every field).
+
+    Built with the real encoder, so a column added to the wire format is counted too.
+    """
+    lm = _worst_landmark(width_px, height_px)
+    return len(encode_reading(robot, 2**53 - 1, 9999999999.999999, [lm] * n_landmarks, 9999.99, 2**53 - 1))
+
+
+def landmarks_that_fit(robot: str, width_px: int = 640, height_px: int = 480,
+                       max_bytes: int = MTU_PAYLOAD_BYTES) -> int:
+    """How many landmarks always fit in ``max_bytes`` (0 when not even a heartbeat does)."""
+    n = 0
+    while n < 1000 and worst_case_bytes(robot, n + 1, width_px, height_px) <= max_bytes:
+        n += 1
+    return n
