@@ -5,6 +5,8 @@ from rangebearing.core.color import to_hsv
 from rangebearing.core.detect import refine
 from rangebearing.core.params import DetectionParams
 from rangebearing.core.refine import band_weights, measure_bands, tile_centroids
+from rangebearing.core.structure import Candidate
+from rangebearing.core.types import LandmarkGeometry
 
 CFG = DetectionParams()
 RED, BLUE = np.array([40, 40, 200.0]), np.array([200, 60, 30.0])
@@ -59,32 +61,38 @@ def test_tile_centroids_by_hand_and_empty_tiles():
     assert x[0] == pytest.approx((1 + 2 + 1.5) / 2.5) and y[0] == pytest.approx(1.0)
 
 
-def boxes(*b):
-    return np.array(b, np.int64).reshape(-1, 4)
+GEOMETRY = LandmarkGeometry()
 
 
-@pytest.mark.parametrize("scale_rows", [6, 30])  # small bands at full resolution, tall ones at 1/f
-def test_refine_finds_rectangle_centres_in_full_resolution_pixels(scale_rows):
-    img = np.full((200, 160, 3), 220, np.uint8)
-    h = scale_rows
-    img[20 : 20 + h, 40:80] = RED
-    img[100 : 100 + h, 42:82] = BLUE
-    (found,) = refine(img, boxes((40, 20, 40, h)), boxes((42, 100, 40, h)), CFG, (1.0, 1.0, 1.0))
+def landmark_image(h: int, x0: int = 40, y0: int = 20, width: int = 40, size=(200, 160)):
+    """A flat landmark: red rows [y0, y0+h), white 40/15·h rows, blue h rows, on light grey."""
+    img = np.full((*size, 3), 200, np.uint8)
+    white = round(h * 40 / 15)
+    img[y0 : y0 + h, x0 : x0 + width] = RED
+    img[y0 + h : y0 + h + white, x0 : x0 + width] = WHITE
+    img[y0 + h + white : y0 + 2 * h + white, x0 : x0 + width] = BLUE
+    cand = Candidate((x0, y0, width, h), (x0, y0 + h + white, width, h), float(white), False, False, False, False, 1.0)
+    return img, cand, white
+
+
+@pytest.mark.parametrize("h", [6, 30])  # small bands at full resolution, tall ones at 1/f
+def test_refine_finds_band_centres_in_full_resolution_pixels(h):
+    img, cand, white = landmark_image(h)
+    (found,) = refine(img, [cand], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0)
     (rx, ry), (bx, by) = found.red_xy_px, found.blue_xy_px
     assert found.red_mass_px == pytest.approx(40 * h, rel=0.1)  # the weight is about the band area
-    assert found.bbox_px == (40, 20, 42, 100 + h - 20)
-    # y weights are linear in coverage: exact. x weights ramp with saturation, which is not
-    # linear in coverage, so a band edge that half-fills a downscaled pixel shifts x a little.
+    assert found.bbox_px == (40, 20, 40, 2 * h + white)
     x_tol = 0.05 if h < 16 else 0.3
-    assert ry == pytest.approx(20 + (h - 1) / 2, abs=0.05) and by == pytest.approx(100 + (h - 1) / 2, abs=0.05)
-    assert rx == pytest.approx(59.5, abs=x_tol) and bx == pytest.approx(61.5, abs=x_tol)
+    assert ry == pytest.approx(20 + (h - 1) / 2, abs=0.05)
+    assert by == pytest.approx(20 + h + white + (h - 1) / 2, abs=0.05)
+    assert rx == pytest.approx(59.5, abs=x_tol) and bx == pytest.approx(59.5, abs=x_tol)
 
 
 def test_a_candidate_whose_band_vanished_is_dropped():
-    img = np.full((100, 100, 3), 220, np.uint8)
-    img[10:16, 10:40] = RED  # no blue anywhere
-    assert refine(img, boxes((10, 10, 30, 6)), boxes((10, 50, 30, 6)), CFG, (1.0, 1.0, 1.0)) == []
-    assert refine(img, boxes(), boxes(), CFG, (1.0, 1.0, 1.0)) == []
+    img, cand, _ = landmark_image(6)
+    img[img[..., 0] == BLUE[0]] = 200  # no blue anywhere
+    assert refine(img, [cand], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0) == []
+    assert refine(img, [], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0) == []
 
 
 def test_a_neighbouring_band_inside_the_window_does_not_pull_the_centroid():

@@ -18,27 +18,60 @@ HueRanges = Sequence[Tuple[int, int]]
 UNIT_GAINS: Gains = (1.0, 1.0, 1.0)
 
 
+NEUTRAL_SAT = 0.25  # saturation scale of the neutral-pixel weight exp(-(S / NEUTRAL_SAT)^2)
+DARK, CLIPPED = 20, 250  # pixels outside this max-channel range carry no colour information
+BALANCE_ITERATIONS = 3
+
+
 def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
-    """Channel gains that make the frame's mean colour neutral (grey-world).
+    """Channel gains that make the frame's *neutral* surfaces neutral (a robust grey-world).
 
     Parameters
     ----------
     bgr : (H, W, 3) uint8 array
-        Any image in BGR order; a downscaled frame is enough.
+        Any image in BGR order; it is area-averaged to about 40×30 first, so a
+        downscaled frame is plenty.
     limit : float
-        Gains are clipped to ``[1/limit, limit]`` so a frame filled with one
-        colour cannot swing the balance arbitrarily.
+        Gains are clipped to ``[1/limit, limit]`` so no scene can swing the
+        balance arbitrarily.
 
     Returns
     -------
     (g_b, g_g, g_r) : tuple of float
         Multiply channel c by ``g_c``; a neutral frame gives ``(1, 1, 1)``.
+
+    Notes
+    -----
+    Plain grey-world averages every pixel, so a navy carpet or a red wall
+    pulls the balance towards its complement (the white body turns cyan).
+    Here very dark pixels (max channel < 20: noise, no hue) and clipped ones
+    (> 250: the channel ratio is lost) are ignored, and each remaining pixel
+    is weighted by ``exp(-(S/0.25)²)`` of its saturation *after* the current
+    gains, iterated three times from unit gains. A colour cast shifts every
+    surface alike and is removed; a strongly coloured surface (S ≈ 0.6–0.9)
+    weighs e^-6 to e^-13 and is ignored however large it is. With no
+    near-neutral pixel at all the gains stay at one.
     """
-    b, g, r, _ = cv2.mean(bgr)
-    grey = (b + g + r) / 3.0
-    if grey <= 1.0:
+    h, w = bgr.shape[:2]
+    f = max(1, min(h // 30, w // 40))
+    tiny = cv2.resize(bgr, (max(1, w // f), max(1, h // f)), interpolation=cv2.INTER_AREA) if f > 1 else bgr
+    p = tiny.reshape(-1, 3).T.astype(np.float32)  # (3, N): channel rows are cheap to combine
+    mx = np.maximum(np.maximum(p[0], p[1]), p[2])
+    p = p[:, (mx >= DARK) & (mx <= CLIPPED)]
+    gains = np.ones(3, np.float32)
+    if p.shape[1] == 0:
         return UNIT_GAINS
-    return tuple(float(np.clip(grey / max(c, 1e-3), 1.0 / limit, limit)) for c in (b, g, r))  # type: ignore[return-value]
+    for _ in range(BALANCE_ITERATIONS):
+        q = p * gains[:, None]
+        hi = np.maximum(np.maximum(q[0], q[1]), q[2])
+        lo = np.minimum(np.minimum(q[0], q[1]), q[2])
+        wgt = np.exp(-np.square((hi - lo) / (hi * NEUTRAL_SAT)))
+        total = float(wgt.sum())
+        if total < 1e-3 * p.shape[1]:  # nothing near neutral: keep what we have
+            break
+        mean = (q @ wgt) / total
+        gains = np.clip(gains * mean.mean() / np.maximum(mean, 1e-3), 1.0 / limit, limit).astype(np.float32)
+    return tuple(float(g) for g in gains)  # type: ignore[return-value]
 
 
 def apply_gains(bgr: np.ndarray, gains: Gains) -> np.ndarray:
@@ -71,10 +104,17 @@ def hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
 
 
 def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int) -> np.ndarray:
-    """0/255 mask of S ≥ s_min and V ≥ v_min."""
+    """0/255 mask of S ≥ s_min and V ≥ v_min; where V is clipped (≥ 250), S ≥ s_min/2 suffices.
+
+    A clipped pixel has lost part of its chroma to saturation of the sensor
+    (a band in a spotlight reads (255, 200, 190)): its hue is still right but
+    its saturation is lower than the paint's.
+    """
     _, s_ok = cv2.threshold(s, s_min - 1, 255, cv2.THRESH_BINARY)
     _, v_ok = cv2.threshold(v, v_min - 1, 255, cv2.THRESH_BINARY)
-    return cv2.bitwise_and(s_ok, v_ok)
+    _, s_half = cv2.threshold(s, s_min // 2 - 1, 255, cv2.THRESH_BINARY)
+    _, clipped = cv2.threshold(v, CLIPPED - 1, 255, cv2.THRESH_BINARY)
+    return cv2.bitwise_or(cv2.bitwise_and(s_ok, v_ok), cv2.bitwise_and(s_half, clipped))
 
 
 def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> np.ndarray:

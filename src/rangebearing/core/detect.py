@@ -20,19 +20,20 @@ in place instead.
 
 from __future__ import annotations
 
-from typing import List, Optional, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
-from .blobs import find_boxes, mask_centroid
+from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
-from .pairing import PairingLimits, pair_bands
+from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows
 from .params import DetectionParams
-from .refine import Pyramid, half_or_area, measure_bands
-from .types import XY, BBox, union
+from .refine import BandFix, Pyramid, half_or_area, measure_bands
+from .structure import Candidate, candidates
+from .types import XY, BBox, LandmarkGeometry, union
 
 
 @frozen
@@ -47,6 +48,10 @@ class BandCentroids:
     blue_mass_px: float
     red_chroma: float
     blue_chroma: float
+    sigma_l_px: float = 0.0  # one-sigma uncertainty of the band spacing L (full-resolution pixels)
+    sigma_x_px: float = 0.0  # ... and of the landmark's image column
+    visible: float = 1.0  # share of the landmark's silhouette seen
+    candidate: Optional[Candidate] = None  # what the structure search found (tracking measures it again)
 
     @property
     def width_px(self) -> float:
@@ -72,48 +77,85 @@ def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: i
     return majority_filter(red, ksize), majority_filter(blue, ksize)
 
 
-def find_pairs(
-    small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, limits: PairingLimits, geometry
-) -> Tuple[np.ndarray, np.ndarray]:
-    """Candidate landmarks in a frame downscaled by ``cfg.downscale``.
-
-    Returns the red and the blue band boxes of each candidate, (K, 4) arrays
-    in full-resolution pixels, row k of one paired with row k of the other.
-    """
-    red, blue = region_masks(small, cfg, gains, ksize)
-    min_area = cfg.min_band_px * cfg.min_band_px
-    reds = find_boxes(red, cfg.downscale, min_area)
-    blues = find_boxes(blue, cfg.downscale, min_area)
-    pairs = pair_bands(reds, blues, geometry, limits, cfg.max_landmarks)
-    idx = np.array(pairs, np.int64).reshape(-1, 2)
-    return reds[idx[:, 0]], blues[idx[:, 1]]
+def find_candidates(
+    small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
+) -> List[Candidate]:
+    """Landmark candidates in a frame downscaled by ``cfg.downscale`` (see :mod:`.structure`)."""
+    hsv = to_hsv(apply_gains(small, gains))
+    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
+    min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
+    return candidates(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 
 
 def refine(
     bgr: np.ndarray,
-    red_boxes: np.ndarray,
-    blue_boxes: np.ndarray,
+    cands: Sequence[Candidate],
     cfg: DetectionParams,
     gains: Gains,
+    geometry: LandmarkGeometry,
+    fy_px: float,
     pyramid: Optional[Pyramid] = None,
 ) -> List[BandCentroids]:
-    """Sub-pixel centroids of every candidate, all bands in one batch; candidates whose band vanished are dropped.
+    """Sub-pixel band centres of every candidate; candidates whose bands vanished are dropped.
 
-    Row k of ``red_boxes`` and of ``blue_boxes`` (full-resolution x, y, w, h)
-    belong to candidate k. Each band is measured inside its box grown by
-    ``downscale + 1`` px, which covers the downscaling and the filter's erosion.
+    Columns come from the saturation-weighted moments of :func:`.refine.measure_bands`
+    (all bands in one batch) or, for a landmark cut on one side, from its other
+    limb; rows from the bands' edges in linear light (:func:`.measure.measure_rows`).
     """
+    if not cands:
+        return []
     m = cfg.downscale + 1
-    reds, blues = [tuple(b) for b in red_boxes.tolist()], [tuple(b) for b in blue_boxes.tolist()]
-    boxes = [b for pair in zip(reds, blues) for b in pair]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(reds), [(m, m)] * len(boxes), cfg, gains, pyramid)
-    found = []
-    for rb, bb, red, blue in zip(reds, blues, fixes[0::2], fixes[1::2]):
-        if red is not None and blue is not None:
-            found.append(
-                BandCentroids(red.xy_px, blue.xy_px, rb, bb, red.mass_px, blue.mass_px, red.chroma_ref, blue.chroma_ref)
-            )
-    return found
+    boxes = [b for c in cands for b in (c.red_bbox_px, c.blue_bbox_px)]
+    # the boxes come from edges found at 1/downscale: grow them by that and a quarter of the band
+    margins = [(m, m + b[3] // 4) for b in boxes]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(cands), margins, cfg, gains, pyramid)
+    found = (combine(bgr, c, r, b, gains, geometry, fy_px, pyramid) for c, r, b in zip(cands, fixes[0::2], fixes[1::2]))
+    return [f for f in found if f is not None]
+
+
+def combine(
+    bgr: np.ndarray,
+    c: Candidate,
+    red: Optional[BandFix],
+    blue: Optional[BandFix],
+    gains: Gains,
+    geometry: LandmarkGeometry,
+    fy_px: float,
+    pyramid: Optional[Pyramid] = None,
+) -> Optional[BandCentroids]:
+    """One candidate's band centres from its moments (``red``, ``blue``) and its edges; ``None`` if a band is gone."""
+    if red is None or blue is None:
+        return None
+    rows = measure_rows(bgr, c, gains, geometry, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
+    if rows is None:
+        return None
+    cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
+    if cols is None:
+        x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
+    else:
+        x_r = x_b = cols[0]
+        sx = cols[1]
+    return BandCentroids(
+        (x_r, _y(red.xy_px[1], rows.red_y_px, rows.red_merged)),
+        (x_b, _y(blue.xy_px[1], rows.blue_y_px, rows.blue_merged)),
+        c.red_bbox_px,
+        c.blue_bbox_px,
+        red.mass_px,
+        blue.mass_px,
+        red.chroma_ref,
+        blue.chroma_ref,
+        sigma_l_px=rows.sigma_l_px,
+        sigma_x_px=sx,
+        visible=c.visible,
+        candidate=c,
+    )
+
+
+def _y(moment_y: float, edge_y: float, merged: bool) -> float:
+    """A band's row: the mean of its moment and its edges' midpoint, or its edge-based row when merged."""
+    # the two are partly independent (gamma-space chroma moments, linear-light edges): their mean beats either
+    return edge_y if merged else 0.5 * (moment_y + edge_y)
 
 
 def detect_paper(bgr: np.ndarray, cfg: DetectionParams) -> List[BandCentroids]:

@@ -15,13 +15,15 @@ import numpy as np
 
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, detect_paper, downscale, find_pairs, refine
+from .detect import BandCentroids, detect_paper, downscale, find_candidates, refine
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
+
+SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
 
 
 class Pipeline:
@@ -58,8 +60,8 @@ class Pipeline:
         key = (w, h)
         if key not in self._cams:
             cam = self.params.camera.for_frame(w, h)
-            far = self.params.model.envelope_range_m[1]
-            band_px = cam.fy_px * self.params.landmark.band_height_m / far / self.params.detection.downscale
+            # the envelope only flags readings: the filter keeps bands out to SEARCH_RANGE_M whatever calibrate wrote
+            band_px = cam.fy_px * self.params.landmark.band_height_m / SEARCH_RANGE_M / self.params.detection.downscale
             self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))
         return self._cams[key]
 
@@ -80,7 +82,9 @@ class Pipeline:
             found = detect_paper(bgr, det)
         else:
             if self.track and self._tracks and self._since_scan < det.full_scan_every - 1:
-                self._tracks, lost = step(bgr, self._tracks, det, self._gains, self.params.landmark, self.limits)
+                self._tracks, lost = step(
+                    bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
+                )
                 # a lost landmark may be just outside its window: scan the whole frame next time
                 self._since_scan = det.full_scan_every if lost else self._since_scan + 1
                 found = [t.bands for t in self._tracks]
@@ -89,8 +93,9 @@ class Pipeline:
                 small = downscale(bgr, det.downscale)
                 if det.white_balance == "grey_world":
                     self._gains = grey_world_gains(small)
-                reds, blues = find_pairs(small, det, self._gains, ksize, self.limits, self.params.landmark)
-                found = refine(bgr, reds, blues, det, self._gains, Pyramid(bgr, small if det.downscale == 2 else None))
+                cands = find_candidates(small, det, self._gains, ksize, self.params.landmark)
+                pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
+                found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close)

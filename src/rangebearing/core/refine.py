@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
+from .color import CLIPPED, Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
 from .params import DetectionParams
 from .types import XY, BBox
 
@@ -25,6 +25,7 @@ from .types import XY, BBox
 REFINE_BAND_PX = 8
 S_RAMP = 40  # saturation ramp half-width for the horizontal weights
 CHROMA_FLOOR = 0.15  # share of a band's mean chroma where its vertical weight starts
+DARK_SHARE = 0.3  # pixels darker than this share of the band's mean V are not band (shading stays above)
 
 
 def band_weights(
@@ -49,8 +50,10 @@ def band_weights(
 
     Notes
     -----
-    Both weights are zero outside the band's hue ranges and for pixels darker
-    than 10.
+    Both weights are zero outside the band's hue ranges, for pixels darker
+    than 10, and for pixels darker than 30 % of the band's mean V (a dark,
+    faintly tinted pedestal or shadow; a shaded band side stays above it).
+    Clipped pixels (V ≥ 250) get full ``w_x``: a highlight keeps its hue.
 
     ``w_x`` weighs by saturation on a linear ramp from ``s_min − 40`` (0) to
     ``s_min + 40`` (255). Saturation does not depend on brightness, so shading
@@ -72,13 +75,19 @@ def band_weights(
     if split < n * h:
         cv2.LUT(hue[split:], hue_table(cfg.blue_hue), dst=gate[split:])
     gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, min(cfg.v_min, 10)))
-    w_x = cv2.bitwise_and(cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP)), gate)
+    core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
+    count = np.maximum(core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0, 1.0)
+    # brightness relative to the band: a dark, faintly tinted pedestal or shadow next to it is no band
+    v_ref = cv2.bitwise_and(val, core).reshape(n, -1).sum(axis=1, dtype=np.int64) / count
+    v_gate = (val.reshape(n, -1) >= (DARK_SHARE * v_ref)[:, None]).astype(np.uint8).reshape(n * h, w) * 255
+    gate = cv2.bitwise_and(gate, v_gate)
+    w_x = cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP))
+    # a clipped highlight (a spotlight's vertical streak) keeps its hue but loses saturation: full weight
+    w_x = cv2.bitwise_and(cv2.max(w_x, cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]), gate)
     chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
     if refs is None:
-        core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
-        count = core.reshape(n, -1).sum(axis=1, dtype=np.int64) / 255.0
         total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
-        refs = total / np.maximum(count, 1.0)
+        refs = total / count
     ref = np.asarray(refs, np.float32).reshape(n, 1)
     floor = np.float32(CHROMA_FLOOR) * ref
     w_y = chroma.reshape(n, h * w).astype(np.float32)

@@ -11,13 +11,14 @@ frame next.
 
 from __future__ import annotations
 
-from typing import List, Sequence, Tuple
+import dataclasses
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from .color import Gains
-from .detect import BandCentroids
+from .detect import BandCentroids, combine
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
@@ -65,22 +66,30 @@ def plausible(old: BandCentroids, red: BandFix, blue: BandFix, geometry: Landmar
     return abs(blue.xy_px[0] - red.xy_px[0]) <= lim.max_dx * w + lim.slack_px
 
 
-def advance(old: Track, red: BandFix, blue: BandFix) -> Track:
-    """The track after this frame: boxes follow the centroids, velocity is the last step."""
+def advance(old: Track, now: BandCentroids) -> Track:
+    """The track after this frame: the new bands, velocity the last step of the centroids."""
     b = old.bands
-    rdx, rdy = red.xy_px[0] - b.red_xy_px[0], red.xy_px[1] - b.red_xy_px[1]
-    bdx, bdy = blue.xy_px[0] - b.blue_xy_px[0], blue.xy_px[1] - b.blue_xy_px[1]
-    bands = BandCentroids(
-        red.xy_px,
-        blue.xy_px,
-        _moved(b.red_bbox_px, rdx, rdy),
-        _moved(b.blue_bbox_px, bdx, bdy),
-        red.mass_px,
-        blue.mass_px,
-        b.red_chroma,
-        b.blue_chroma,
-    )
-    return Track(bands, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
+    rdx, rdy = now.red_xy_px[0] - b.red_xy_px[0], now.red_xy_px[1] - b.red_xy_px[1]
+    bdx, bdy = now.blue_xy_px[0] - b.blue_xy_px[0], now.blue_xy_px[1] - b.blue_xy_px[1]
+    return Track(now, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
+
+
+def remeasure(
+    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry,
+    fy_px: float,
+) -> Optional[BandCentroids]:
+    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments."""
+    rdx, rdy = red.xy_px[0] - old.red_xy_px[0], red.xy_px[1] - old.red_xy_px[1]
+    bdx, bdy = blue.xy_px[0] - old.blue_xy_px[0], blue.xy_px[1] - old.blue_xy_px[1]
+    rb, bb = _moved(old.red_bbox_px, rdx, rdy), _moved(old.blue_bbox_px, bdx, bdy)
+    if old.candidate is None:
+        return dataclasses.replace(old, red_xy_px=red.xy_px, blue_xy_px=blue.xy_px, red_bbox_px=rb, blue_bbox_px=bb,
+                                   red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
+    cand = dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
+    now = combine(bgr, cand, red, blue, gains, geometry, fy_px)
+    if now is None:
+        return None
+    return dataclasses.replace(now, red_chroma=old.red_chroma, blue_chroma=old.blue_chroma)
 
 
 def step(
@@ -90,6 +99,7 @@ def step(
     gains: Gains,
     geometry: LandmarkGeometry,
     limits: PairingLimits,
+    fy_px: float = 634.0,
 ) -> Tuple[List[Track], bool]:
     """Follow every track into this frame; returns the surviving tracks and whether any was lost."""
     boxes: List[BBox] = []
@@ -102,10 +112,13 @@ def step(
     kept: List[Track] = []
     lost = False
     for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2]):
-        if red is None or blue is None or not plausible(t.bands, red, blue, geometry, limits):
+        now = None
+        if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits):
+            now = remeasure(bgr, t.bands, red, blue, gains, geometry, fy_px)
+        if now is None:
             lost = True
             continue
-        kept.append(advance(t, red, blue))
+        kept.append(advance(t, now))
     return _distinct(kept), lost
 
 

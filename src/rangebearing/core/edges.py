@@ -1,0 +1,124 @@
+"""Sub-pixel band edges in linear light: where each band starts and ends, row by row and column by column.
+
+In linear light a pixel straddling an edge is the coverage-weighted mix of
+its two sides, so any channel combination is linear in coverage. The excess
+``R − (G+B)/2`` (red) or ``B − (R+G)/2`` (blue) is the paint's level inside a
+band and the background's level outside it, and the edge between two rows
+``a`` (inside) and ``b`` (outside) lies at::
+
+    edge = (a − ½) + Σ_{y=a..b} (p(y) − bg) / (level − bg)      (going down)
+
+for any symmetric blur: the two-level integral. A band's centre is the mean
+of its two edges when both are its own; when its outer edge merges with a
+background of its colour (``level − bg`` small), the inner edge and the white
+body's height place it instead, since on the cylinder's near surface heights
+map linearly to rows. The sRGB-like encoding is undone with a 2.2 power.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Optional, Tuple
+
+import numpy as np
+
+from .._compat import frozen
+from .color import Gains
+
+GAMMA = 2.2
+BG_ROWS = 4  # rows averaged for a background level
+MERGE_CONTRAST = 0.5  # an outer edge whose level step is below this share of the band's level is merged
+
+
+@functools.lru_cache(maxsize=2)
+def linear_table(gamma: float = GAMMA) -> np.ndarray:
+    """(256,) float32: 8-bit encoded value → linear light in [0, 1]."""
+    return (np.arange(256, dtype=np.float32) / 255.0) ** np.float32(gamma)
+
+
+def excess(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray]:
+    """Red and blue excess ``(H, W)`` float32 of a BGR uint8 tile, balanced, in linear light."""
+    lin = linear_table()[tile]
+    b, g, r = lin[..., 0] * gains[0], lin[..., 1] * gains[1], lin[..., 2] * gains[2]
+    return r - 0.5 * (g + b), b - 0.5 * (r + g)
+
+
+def edge_down(p: np.ndarray, a: int, b: int, level: float, bg: float) -> float:
+    """Edge between row ``a`` (inside, level ``level``) and row ``b`` > a (outside, ``bg``) of profile ``p``."""
+    return (a - 0.5) + float(np.sum(p[a : b + 1] - bg)) / (level - bg)
+
+
+def edge_up(p: np.ndarray, a: int, b: int, level: float, bg: float) -> float:
+    """Edge between row ``a`` (inside) and row ``b`` < a (outside) of profile ``p``, going up."""
+    return (a + 0.5) - float(np.sum(p[b : a + 1] - bg)) / (level - bg)
+
+
+@frozen
+class BandEdges:
+    """One band's rows: centre, inner edge and the spread of its per-column centres (tile pixels)."""
+
+    centre: float
+    inner: float
+    merged: bool
+    sigma: float  # one-sigma uncertainty of ``centre`` from the column-to-column scatter
+
+
+def band_rows(
+    p2d: np.ndarray, top: int, bottom: int, inner_down: bool, white_end: int, outer_end: int
+) -> Optional[BandEdges]:
+    """Measure one band in a (rows, cols) excess array whose rows ``top..bottom`` are its expected rows.
+
+    ``inner_down``: the inner (white) edge is below the band (red); otherwise above (blue).
+    ``white_end`` is the row in the white body where the inner integral stops; ``outer_end`` the
+    last background row beyond the outer edge (clipped to the array).
+    """
+    p = p2d.mean(axis=1)
+    n = len(p)
+    top, bottom = max(0, top), min(n - 1, bottom)
+    core_lo, core_hi = top + (bottom - top) // 4, bottom - (bottom - top) // 4
+    if core_hi < core_lo:
+        return None
+    mid = (core_lo + core_hi) // 2
+    level = float(p[core_lo : core_hi + 1].mean())
+    white_end = min(n - 1, max(0, white_end))
+    outer_end = min(n - 1, max(0, outer_end))
+    w_bg = _level_beyond(p, white_end, inner_down)
+    if level - w_bg <= 0.02:  # no colour step at the white body: not a band
+        return None
+    if inner_down:
+        inner = edge_down(p, mid, white_end, level, w_bg)
+        o_bg = _level_beyond(p, outer_end, False) if outer_end < mid else level
+        merged = outer_end >= mid or level - o_bg < MERGE_CONTRAST * level
+        outer = inner if merged else edge_up(p, mid - 1, outer_end, level, o_bg)
+    else:
+        inner = edge_up(p, mid, white_end, level, w_bg)
+        o_bg = _level_beyond(p, outer_end, True) if outer_end > mid else level
+        merged = outer_end <= mid or level - o_bg < MERGE_CONTRAST * level
+        outer = inner if merged else edge_down(p, mid + 1, outer_end, level, o_bg)
+    centre = 0.5 * (inner + outer)
+    sigma = _column_sigma(p2d, level, w_bg, mid, white_end, inner_down)
+    return BandEdges(centre, inner, merged, sigma)
+
+
+def _level_beyond(p: np.ndarray, row: int, down: bool, rows: int = BG_ROWS) -> float:
+    """Mean of ``p`` over ``rows`` rows from ``row`` on, away from the band: one row is too noisy
+    (its error is multiplied by every row of the integral)."""
+    seg = p[row : row + rows] if down else p[max(0, row - rows + 1) : row + 1]
+    return float(seg.mean()) if seg.size else float(p[row])
+
+
+def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, down: bool) -> float:
+    """Standard error of the inner edge from the scatter of the per-column edges (rows)."""
+    cols = p2d.shape[1]
+    if cols < 3:
+        return 0.5
+    lo, hi = (mid, end) if down else (end, mid)
+    sums = (p2d[lo : hi + 1] - bg).sum(axis=0) / (level - bg)
+    return float(np.std(sums, ddof=1) / np.sqrt(cols))
+
+
+def limb(profile: np.ndarray, core: int, end: int, level: float, bg: float) -> float:
+    """Sub-pixel limb column from a column profile: going right when ``end > core``, else left."""
+    if end > core:
+        return edge_down(profile, core, end, level, bg)
+    return edge_up(profile, core, end, level, bg)

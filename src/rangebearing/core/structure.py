@@ -1,0 +1,227 @@
+"""Landmark candidates from the landmark's vertical structure, not from two isolated blobs.
+
+Down every image column a landmark reads red → white → blue: a red run, a
+white run, a blue run, with the white run's height ``h`` fixing the rest of
+the shape (bands ``h·15/40`` tall, the cylinder ``h·35/40`` wide). The inner
+red/white and white/blue edges stay sharp and local when a band's *outer* edge
+merges with a background of its colour (a red box above it, a blue mat below),
+and a red box behind the band or a neighbour's band beside it makes no such
+column. So:
+
+1. pair red and blue regions that could hold one landmark (overlapping
+   columns, blue starting below red), at most ``MAX_REGIONS`` of each colour;
+2. in each pair's window, find per column the red-bottom edge ``y1`` and the
+   blue-top edge ``y2`` with (mostly) white between them;
+3. cut the columns into runs whose edges are continuous: a landmark in front
+   of another has other edges, so each keeps its own columns;
+4. check each run against the cylinder's silhouette (``n`` columns ≈ ``h·35/40``):
+   a run ``k`` silhouettes wide with band-shaped runs is ``k`` landmarks side by
+   side at one range, split evenly; a narrower run is a partly hidden landmark
+   (``visible`` < 1), a much wider one is no landmark.
+
+All coordinates here are in the downscaled masks' pixels until
+:func:`candidates` converts them to full-resolution pixels.
+"""
+
+from __future__ import annotations
+
+from typing import List, Tuple
+
+import cv2
+import numpy as np
+
+from .._compat import frozen
+from .types import BBox, LandmarkGeometry
+
+MAX_REGIONS = 48  # largest regions of each colour considered (bounds the cost of a frame full of specks)
+MAX_PAIRS_PER_LANDMARK = 4  # region pairs examined per landmark wanted
+WHITE_SHARE = 0.6  # share of the rows between the edges that must be white
+EDGE_STEP = 1  # largest jump of an edge between neighbouring columns (plus 5 % of h)
+MERGED = 1.7  # a band run longer than this many expected band heights is merged with something
+SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
+MIN_VISIBLE = 0.3  # narrower runs than this share of a silhouette are not reported
+WHITE_S_MAX, WHITE_V_MIN = 80, 40  # the white body: low saturation, not dark
+
+
+@frozen
+class Candidate:
+    """One landmark hypothesis, in full-resolution pixels.
+
+    ``red_bbox_px``/``blue_bbox_px`` are the expected band boxes (columns of
+    the landmark's run, rows from its inner edges and white height).
+    ``red_merged``/``blue_merged``: the band's colour runs on past its outer
+    edge (a same-coloured background). ``cut_left``/``cut_right``: the run
+    ends at something other than the cylinder's limb (a nearer landmark, a
+    neighbour, a same-coloured background). ``visible`` is the run's width over
+    the silhouette's, at most 1.
+    """
+
+    red_bbox_px: BBox
+    blue_bbox_px: BBox
+    white_px: float
+    red_merged: bool
+    blue_merged: bool
+    cut_left: bool
+    cut_right: bool
+    visible: float
+
+
+def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
+    """``(0, x, y, w, h, box area)`` rows of the external regions of a 0/255 mask whose box holds at
+    least ``min_area`` pixels, the ``MAX_REGIONS`` largest (contours: far cheaper than labelling)."""
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+    if not contours:
+        return np.zeros((0, 6), np.int64)
+    st = np.array([cv2.boundingRect(c) for c in contours], np.int64).reshape(-1, 4)
+    area = st[:, 2] * st[:, 3]
+    keep = area >= min_area
+    st, area = st[keep], area[keep]
+    if len(st) > MAX_REGIONS:
+        top = np.argsort(-area, kind="stable")[:MAX_REGIONS]
+        st, area = st[top], area[top]
+    return np.column_stack((np.zeros(len(st), np.int64), st, area))
+
+
+def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tuple[int, int]]:
+    """Row indices of red and blue regions that may hold one landmark: shared columns, blue
+    starting below red's top and not farther below red's bottom than a white body could be."""
+    if len(reds) == 0 or len(blues) == 0:
+        return []
+    rx0, ry0, rw, rh = (reds[:, k, None] for k in (1, 2, 3, 4))
+    bx0, by0, bw, bh = (blues[None, :, k] for k in (1, 2, 3, 4))
+    overlap = np.minimum(rx0 + rw, bx0 + bw) - np.maximum(rx0, bx0)
+    gap = by0 - (ry0 + rh)
+    ok = (overlap >= 2) & (by0 > ry0) & (by0 + bh > ry0 + rh) & (gap <= 1.6 * np.minimum(rw, bw) + 3)
+    i, j = np.nonzero(ok)
+    order = np.argsort(-overlap[i, j], kind="stable")[:max_pairs]
+    return list(zip(i[order].tolist(), j[order].tolist()))
+
+
+def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[np.ndarray, ...]:
+    """Per column of a window: ``(ok, y1, y2, run_r, run_b)``.
+
+    ``y1`` is the last red row above the blue-top row ``y2``, with at least
+    ``WHITE_SHARE`` of the rows between them white; of several such pairs in a
+    column, the whitest (then the shortest) wins. ``run_r``/``run_b`` are the
+    lengths of the red run ending at ``y1`` and the blue run starting at ``y2``.
+    """
+    h, w = red.shape
+    rows = np.arange(h, dtype=np.int32)[:, None]
+    red_bottom = red.copy()
+    red_bottom[:-1] &= ~red[1:]
+    red_bottom[-1] = False
+    last_rb = np.maximum.accumulate(np.where(red_bottom, rows, -1), axis=0)
+    last_not_red = np.maximum.accumulate(np.where(red, -1, rows), axis=0)
+    next_not_blue = np.minimum.accumulate(np.where(blue, h, rows)[::-1], axis=0)[::-1]
+    blue_top = blue.copy()
+    blue_top[1:] &= ~blue[:-1]
+    blue_top[0] = False
+    cum_w = np.cumsum(white, axis=0, dtype=np.int32)
+    y2 = np.broadcast_to(rows, (h, w))
+    y1 = np.vstack((np.full((1, w), -1, np.int32), last_rb[:-1]))
+    cols = np.arange(w)
+    safe_y1 = np.maximum(y1, 0)
+    gap = y2 - y1 - 1
+    whites = np.take_along_axis(cum_w, np.maximum(y2 - 1, 0), 0) - np.take_along_axis(cum_w, safe_y1, 0)
+    valid = blue_top & (y1 >= 0) & (gap >= 2) & (whites >= WHITE_SHARE * gap)
+    share = np.where(valid, whites / np.maximum(gap, 1) - 1e-3 * gap, -1.0)
+    best = np.argmax(share, axis=0)
+    ok = share[best, cols] > -1.0
+    b1 = y1[best, cols]
+    run_r = b1 - np.take_along_axis(last_not_red, np.maximum(b1, 0)[None, :], 0)[0]
+    run_b = next_not_blue[best, cols] - best
+    return ok, b1, best, run_r, run_b
+
+
+def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> List[Tuple[int, int]]:
+    """``[start, stop)`` column ranges where the edges continue from column to column."""
+    step = EDGE_STEP + 0.05 * (y2 - y1)
+    jump = np.zeros(len(ok), bool)
+    jump[1:] = (np.abs(np.diff(y1)) > step[1:]) | (np.abs(np.diff(y2)) > step[1:])
+    prev_ok = np.concatenate(([False], ok[:-1]))
+    next_ok = np.concatenate((ok[1:], [False]))
+    next_jump = np.concatenate((jump[1:], [True]))
+    starts = np.flatnonzero(ok & (~prev_ok | jump))
+    stops = np.flatnonzero(ok & (~next_ok | next_jump)) + 1
+    return list(zip(starts.tolist(), stops.tolist()))
+
+
+def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
+    """Whether ``mask`` is mostly set in ``rows`` of column ``col`` (outside the image: no)."""
+    if col < 0 or col >= mask.shape[1]:
+        return False
+    seg = mask[max(0, rows[0]) : max(0, rows[1]), col]
+    return seg.size > 0 and float(seg.mean()) > 127.0
+
+
+def candidates(
+    red: np.ndarray,
+    blue: np.ndarray,
+    hsv: np.ndarray,
+    scale: int,
+    geometry: LandmarkGeometry,
+    max_landmarks: int,
+    min_area: int = 2,
+) -> List[Candidate]:
+    """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
+
+    Returns at most ``max_landmarks`` candidates in full-resolution pixels,
+    those with the widest shared columns first. The work is bounded: at most
+    ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
+    pairs per landmark wanted are examined, whatever the frame holds.
+    """
+    reds, blues = region_stats(red, min_area), region_stats(blue, min_area)
+    white_h = geometry.height_m - 2 * geometry.band_height_m
+    band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
+    out: List[Candidate] = []
+    taken: List[BBox] = []
+    for i, j in region_pairs(reds, blues, MAX_PAIRS_PER_LANDMARK * max_landmarks):
+        r, b = reds[i], blues[j]
+        x0, x1 = max(r[1], b[1]), min(r[1] + r[3], b[1] + b[3])
+        y0, y1 = r[2], b[2] + b[4]
+        win = (slice(y0, y1), slice(x0, x1))
+        white = (hsv[win][..., 1] < WHITE_S_MAX) & (hsv[win][..., 2] >= WHITE_V_MIN)
+        ok, e1, e2, run_r, run_b = column_edges(red[win] > 0, blue[win] > 0, white)
+        for s0, s1 in runs(ok, e1, e2):
+            n = s1 - s0
+            gap = float(np.median(e2[s0:s1] - e1[s0:s1] - 1))
+            hb, w_exp = band_k * gap, width_k * gap
+            ratio = n / w_exp
+            red_merged = float(np.median(run_r[s0:s1])) > MERGED * hb + 1
+            blue_merged = float(np.median(run_b[s0:s1])) > MERGED * hb + 1
+            k = round(ratio)
+            if ratio > 1 + SPLIT_TOL:
+                if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
+                    continue
+                pieces = [(s0 + n * q / k, s0 + n * (q + 1) / k) for q in range(k)]
+            elif ratio < MIN_VISIBLE or n < 2:
+                continue
+            else:
+                pieces = [(float(s0), float(s1))]
+            ey1 = float(np.median(e1[s0:s1])) + y0
+            ey2 = float(np.median(e2[s0:s1])) + y0
+            rrows = (round(ey1 - hb + 1), int(ey1) + 1)
+            brows = (int(ey2), round(ey2 + hb))
+            reach = 1 + round(0.08 * w_exp)
+            for q, (p0, p1) in enumerate(pieces):
+                c0, c1 = x0 + round(p0), x0 + round(p1)
+                left = q > 0 or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
+                right = (q < len(pieces) - 1 or _continues(red, rrows, c1 - 1 + reach)
+                         or _continues(blue, brows, c1 - 1 + reach))
+                rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
+                bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
+                if any(_overlaps(rb, t) for t in taken):
+                    continue
+                taken.append(rb)
+                vis = min(1.0, (p1 - p0) / w_exp) if len(pieces) == 1 else 1.0
+                out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis))
+                if len(out) >= max_landmarks:
+                    return out
+    return out
+
+
+def _overlaps(a: BBox, b: BBox) -> bool:
+    """Whether boxes a and b share more than half of the smaller one."""
+    w = min(a[0] + a[2], b[0] + b[2]) - max(a[0], b[0])
+    h = min(a[1] + a[3], b[1] + b[3]) - max(a[1], b[1])
+    return w > 0 and h > 0 and w * h > 0.5 * min(a[2] * a[3], b[2] * b[3])
