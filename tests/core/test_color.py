@@ -45,3 +45,37 @@ def test_grey_world_undoes_a_warm_cast():
 def test_grey_world_gains_are_clipped():
     gains = grey_world_gains(patch((2, 2, 250)), limit=2.0)
     assert min(gains) >= 0.5 and max(gains) <= 2.0
+
+
+def split_frame(top_bgr, bottom_bgr, bottom_share):
+    """A 40×40 frame: ``top_bgr`` above, ``bottom_bgr`` filling the bottom ``bottom_share`` of the rows."""
+    img = np.full((40, 40, 3), top_bgr, np.uint8)
+    img[40 - round(40 * bottom_share) :] = bottom_bgr
+    return img
+
+
+@pytest.mark.parametrize(
+    "surface",
+    [
+        (90, 30, 20),  # a navy carpet (BGR) over most of the frame
+        (25, 30, 170),  # a red wall
+        (40, 150, 40),  # a green floor
+    ],
+)
+def test_a_large_coloured_surface_does_not_shift_the_balance(surface):
+    warm_white = (150, 175, 200)  # the white body and walls under a warm cast
+    gains = grey_world_gains(split_frame(warm_white, surface, 0.7))
+    b, g, r = apply_gains(patch(warm_white), gains)[0, 0].astype(int)
+    assert max(b, g, r) - min(b, g, r) <= 4  # the neutral surfaces come out neutral
+
+
+def test_dark_and_clipped_pixels_do_not_vote():
+    frame = split_frame((120, 120, 120), (8, 2, 12), 0.5)  # half the frame nearly black, faintly tinted
+    frame[:10] = (255, 255, 230)  # a blown-out window
+    assert grey_world_gains(frame) == pytest.approx((1.0, 1.0, 1.0), abs=0.01)
+
+
+def test_a_clipped_highlight_on_a_band_keeps_its_class():
+    hsv = to_hsv(patch((190, 200, 255)))  # a red band in a spotlight: red clipped, saturation ~0.25
+    assert (hue_mask(hsv, RED_HUE, 90, 25) == 255).all()
+    assert not (hue_mask(to_hsv(patch((190, 200, 240))), RED_HUE, 90, 25) == 255).any()  # unclipped: too pale

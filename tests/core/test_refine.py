@@ -1,3 +1,5 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -86,6 +88,25 @@ def test_refine_finds_band_centres_in_full_resolution_pixels(h):
     assert ry == pytest.approx(20 + (h - 1) / 2, abs=0.05)
     assert by == pytest.approx(20 + h + white + (h - 1) / 2, abs=0.05)
     assert rx == pytest.approx(59.5, abs=x_tol) and bx == pytest.approx(59.5, abs=x_tol)
+
+
+def test_a_band_merged_with_a_red_box_above_is_placed_from_its_inner_edge():
+    img, cand, white = landmark_image(6, y0=40)  # white 16 rows: the landmark's 15/40/15 exactly
+    img[10:40, 20:100] = RED  # a red box behind, touching the band's top edge
+    merged = dataclasses.replace(cand, red_merged=True)
+    (found,) = refine(img, [merged], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0)
+    assert found.red_xy_px[1] == pytest.approx(40 + 2.5, abs=0.02)  # the box does not pull it up
+    assert found.blue_xy_px[1] == pytest.approx(40 + 6 + white + 2.5, abs=0.02)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 5])
+def test_band_centres_move_exactly_with_the_landmark_also_across_the_downscaling_grid(k):
+    img, cand, _ = landmark_image(6, y0=30, x0=50)
+    moved, cand_k, _ = landmark_image(6, y0=30 + k, x0=50 + k)
+    (a,) = refine(img, [cand], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0)
+    (b,) = refine(moved, [cand_k], CFG, (1.0, 1.0, 1.0), GEOMETRY, 634.0)
+    for p, q in ((a.red_xy_px, b.red_xy_px), (a.blue_xy_px, b.blue_xy_px)):
+        assert q[0] - p[0] == pytest.approx(k, abs=1e-4) and q[1] - p[1] == pytest.approx(k, abs=1e-4)
 
 
 def test_a_candidate_whose_band_vanished_is_dropped():

@@ -22,6 +22,7 @@ from .params import PipelineParams
 from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
+from .uncertainty import reading_sigma
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
 
@@ -105,7 +106,12 @@ class Pipeline:
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
 
     def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:
-        rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, self.params.model, self.params.landmark)
+        model = self.params.model
+        rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, model, self.params.landmark)
+        c_m = model.c_m if model.kind == "pinhole" else 0.0
+        s_r, s_b = reading_sigma(
+            rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, c.width_px, c.visible, c_m, cam.fx_px
+        )
         return Landmark(
             range_m=rng,
             bearing_rad=bearing,
@@ -117,4 +123,7 @@ class Pipeline:
             width_px=c.width_px,
             bbox_px=c.bbox_px,
             in_envelope=in_envelope(rng, bearing, self.params.model),
+            range_sigma_m=s_r,
+            bearing_sigma_rad=s_b,
+            visible=c.visible,
         )

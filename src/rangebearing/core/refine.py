@@ -50,9 +50,9 @@ def band_weights(
 
     Notes
     -----
-    Both weights are zero outside the band's hue ranges, for pixels darker
-    than 10, and for pixels darker than 30 % of the band's mean V (a dark,
-    faintly tinted pedestal or shadow; a shaded band side stays above it).
+    Both weights are zero outside the band's hue ranges and for pixels darker
+    than 10; ``w_y`` also for pixels darker than 30 % of the band's mean V (a
+    dark, faintly tinted pedestal below the band; a shaded side stays above it).
     Clipped pixels (V ≥ 250) get full ``w_x``: a highlight keeps its hue.
 
     ``w_x`` weighs by saturation on a linear ramp from ``s_min − 40`` (0) to
@@ -80,11 +80,11 @@ def band_weights(
     # brightness relative to the band: a dark, faintly tinted pedestal or shadow next to it is no band
     v_ref = cv2.bitwise_and(val, core).reshape(n, -1).sum(axis=1, dtype=np.int64) / count
     v_gate = (val.reshape(n, -1) >= (DARK_SHARE * v_ref)[:, None]).astype(np.uint8).reshape(n * h, w) * 255
-    gate = cv2.bitwise_and(gate, v_gate)
     w_x = cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP))
     # a clipped highlight (a spotlight's vertical streak) keeps its hue but loses saturation: full weight
     w_x = cv2.bitwise_and(cv2.max(w_x, cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]), gate)
-    chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), gate)  # S·V/255 = max − min
+    # only rows need the brightness gate (a pedestal lies below the band; the dark limb must stay for x)
+    chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), cv2.bitwise_and(gate, v_gate))
     if refs is None:
         total = cv2.bitwise_and(chroma, core).reshape(n, -1).sum(axis=1, dtype=np.int64)
         refs = total / count

@@ -1,0 +1,122 @@
+"""The structure search: red→white→blue columns, runs of continuous edges, splitting and cut sides."""
+
+import numpy as np
+import pytest
+
+from rangebearing.core.color import to_hsv
+from rangebearing.core.structure import candidates, column_edges, region_pairs, region_stats, runs
+from rangebearing.core.types import LandmarkGeometry
+
+RED, BLUE, WHITE, GREY = (40, 40, 200), (200, 60, 30), (220, 220, 220), (120, 120, 120)
+GEOMETRY = LandmarkGeometry()
+
+
+def column(*rows):
+    """A one-column (N, 1) bool mask from a string of r/b/w/. characters, for each class."""
+    s = "".join(rows)
+    return tuple(np.array([[c == k] for c in s]) for k in "rbw")
+
+
+def test_column_edges_find_the_inner_edges_and_band_runs():
+    red, blue, white = column("..rr", "wwww", "bb..")
+    ok, y1, y2, run_r, run_b = column_edges(red, blue, white)
+    assert ok.tolist() == [True] and (y1[0], y2[0]) == (3, 8) and (run_r[0], run_b[0]) == (2, 2)
+
+
+@pytest.mark.parametrize(
+    "pattern",
+    [
+        "rr..bb",  # nothing white between: a red box beside a blue one
+        "bbwwrr",  # blue above red
+        "rrwbb.",  # one white row: too thin for a white body
+    ],
+)
+def test_columns_without_red_white_blue_are_rejected(pattern):
+    ok = column_edges(*column(pattern))[0]
+    assert ok.tolist() == [False]
+
+
+def test_the_whitest_pair_of_edges_wins_in_a_column():
+    # a red box high up, grey floor, then the landmark's own red band, white body, blue band
+    red, blue, white = column("rr...rr", "wwww", "bb")
+    ok, y1, y2, _, _ = column_edges(red, blue, white)
+    assert ok[0] and (y1[0], y2[0]) == (6, 11)
+
+
+def test_runs_break_where_an_edge_jumps():
+    ok = np.array([True] * 6 + [False] + [True] * 3)
+    y1 = np.array([10, 10, 11, 10, 20, 20, 0, 5, 5, 5])
+    y2 = np.array([30, 30, 30, 31, 40, 40, 0, 15, 15, 15])
+    assert runs(ok, y1, y2) == [(0, 4), (4, 6), (7, 10)]
+
+
+def landmark(img, x0, y0, band, width):
+    """Paint a flat landmark (band, 40/15·band white, band) into a BGR image."""
+    white = round(band * 40 / 15)
+    img[y0 : y0 + band, x0 : x0 + width] = RED
+    img[y0 + band : y0 + band + white, x0 : x0 + width] = WHITE
+    img[y0 + band + white : y0 + 2 * band + white, x0 : x0 + width] = BLUE
+
+
+def search(img, max_landmarks=16):
+    hsv = to_hsv(img)
+    red = ((hsv[..., 0] < 10) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+    blue = ((hsv[..., 0] > 98) & (hsv[..., 0] < 132) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+    return candidates(red, blue, hsv, 1, GEOMETRY, max_landmarks)
+
+
+def test_one_landmark_is_one_whole_candidate():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    landmark(img, 50, 20, 9, 21)  # 9 px bands, 24 px white: a silhouette of 21 columns
+    (c,) = search(img)
+    assert c.red_bbox_px == (50, 20, 21, 9) and c.blue_bbox_px == (50, 53, 21, 9)
+    assert c.white_px == 24 and c.visible == pytest.approx(1.0)
+    assert not (c.red_merged or c.blue_merged or c.cut_left or c.cut_right)
+
+
+def test_two_touching_landmarks_at_one_range_are_split_with_their_inner_sides_cut():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    landmark(img, 40, 20, 9, 21)
+    landmark(img, 61, 20, 9, 21)  # touching: one red region, one blue region, 42 columns
+    left, right = sorted(search(img), key=lambda c: c.red_bbox_px[0])
+    assert left.red_bbox_px[0] == 40 and right.red_bbox_px[0] == 61
+    assert (left.cut_left, left.cut_right, right.cut_left, right.cut_right) == (False, True, True, False)
+
+
+def test_a_landmark_half_hidden_behind_a_nearer_one_keeps_its_visible_columns():
+    img = np.full((160, 200, 3), GREY, np.uint8)
+    landmark(img, 70, 35, 6, 14)  # far one, 14 columns wide
+    landmark(img, 78, 20, 12, 28)  # near one in front, covering the far one's right part
+    found = sorted(search(img), key=lambda c: c.white_px)
+    far, near = found
+    assert near.white_px == 32 and near.visible == pytest.approx(1.0)
+    assert far.white_px == 16 and far.red_bbox_px[0] == 70 and far.red_bbox_px[2] == 8
+    assert far.cut_right and not far.cut_left and far.visible == pytest.approx(9 / 14)
+
+
+def test_a_red_box_on_top_of_the_band_marks_it_merged():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    img[0:20, 30:100] = RED  # a red box behind, touching the band's top
+    landmark(img, 50, 20, 9, 21)
+    (c,) = search(img)
+    assert c.red_merged and not c.blue_merged
+    assert not (c.cut_left or c.cut_right)  # the box ends above the band: its sides are still limbs
+
+
+def test_a_wide_red_white_blue_stripe_is_no_landmark():
+    img = np.full((120, 200, 3), GREY, np.uint8)
+    img[20:40, 10:190] = RED  # a poster above a white wall above a blue mat
+    img[40:64, 10:190] = WHITE
+    img[64:90, 10:190] = BLUE
+    assert search(img) == []
+
+
+def test_the_search_is_bounded_by_max_landmarks_and_the_region_cap():
+    img = np.full((480, 640, 3), GREY, np.uint8)
+    for i in range(8):
+        for j in range(12):
+            landmark(img, 10 + 52 * j, 5 + 58 * i, 6, 14)
+    assert len(search(img, max_landmarks=16)) == 16
+    reds = region_stats(((to_hsv(img)[..., 1] > 90) & (to_hsv(img)[..., 0] < 10)).astype(np.uint8) * 255, 2)
+    assert len(reds) == 48  # the largest 48 of 96 regions
+    assert len(region_pairs(reds, reds, 10)) <= 10
