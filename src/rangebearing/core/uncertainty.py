@@ -40,7 +40,8 @@ def range_sigma_m(
     range_m: float, c_m: float, l_px: float, sigma_l_px: float, visible: float, radius_m: float = 0.0175
 ) -> float:
     """One-sigma range error (m) of a reading at ``range_m`` from band spacing ``l_px`` ± ``sigma_l_px``."""
-    s_l = math.sqrt((EDGE_SCATTER * sigma_l_px) ** 2 + 2 * EDGE_FLOOR_PX**2 + (HIDDEN_PX * (1.0 - min(1.0, visible))) ** 2)
+    hidden = HIDDEN_PX * (1.0 - min(1.0, visible))
+    s_l = math.sqrt((EDGE_SCATTER * sigma_l_px) ** 2 + 2 * EDGE_FLOOR_PX**2 + hidden**2)
     spacing = max(range_m - c_m, 0.0) * s_l / max(l_px, 1e-6)
     return math.sqrt(spacing**2 + (MODEL_FLOOR * range_m) ** 2 + (DEPTH_SHARE * radius_m) ** 2)
 
