@@ -31,7 +31,7 @@ class DetectionParams:
     s_min: int = 90
     v_min: int = 25
     min_band_px: float = 3.0
-    max_landmarks: int = 12  # the most whose datagram always fits one packet (run --check enforces it)
+    max_landmarks: int = 8  # the most whose datagram always fits one packet (run --check enforces it)
     tracking: bool = True
     full_scan_every: int = 8
 

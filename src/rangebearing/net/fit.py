@@ -60,17 +60,20 @@ def _worst_landmark(width_px: int, height_px: int) -> Landmark:
         range_m=99.9999, bearing_rad=-3.14159, d_v_m=-99.9999, d_h_m=-99.9999, l_px=edge,
         red_xy_px=(edge, edge), blue_xy_px=(edge, edge), width_px=edge, bbox_px=(0, 0, 1, 1),
         in_envelope=False, range_sigma_m=99.9999, bearing_sigma_rad=3.14159, visible=0.99,
-        track_id=2**31 - 1, range_rate_mps=-99.999, bearing_rate_radps=-9.9999,
+        track_id=99_999_999, range_rate_mps=-99.999, bearing_rate_radps=-9.9999,
     )
 
 
 def worst_case_bytes(robot: str, n_landmarks: int, width_px: int = 640, height_px: int = 480) -> int:
     """The largest datagram ``n_landmarks`` landmarks can make (every column, every digit, every field).
 
-    Built with the real encoder, so a column added to the wire format is counted too.
+    Built with the real encoder, so a column added to the wire format is counted too. Bounds
+    assumed: ``seq`` and ``dropped`` under 10**11 (a century at 30 fps), ranges and offsets
+    under 100 m, track ids under 10**8, centroids inside the image; a frame beyond them is
+    still sent, by :func:`encode_fitting`, with its farthest landmarks counted in ``omitted``.
     """
     lm = _worst_landmark(width_px, height_px)
-    return len(encode_reading(robot, 2**53 - 1, 9999999999.999999, [lm] * n_landmarks, 9999.99, 2**53 - 1))
+    return len(encode_reading(robot, 10**11 - 1, 4102444800.123456, [lm] * n_landmarks, 9999.99, 10**11 - 1))
 
 
 def landmarks_that_fit(robot: str, width_px: int = 640, height_px: int = 480,
