@@ -74,3 +74,15 @@ class TruthError(RangeBearingError, ValueError):
 
 class OutputError(RangeBearingError, OSError):
     """A file or folder the command was asked to write cannot be written."""
+
+
+class RequestError(RangeBearingError, ValueError):
+    """A request to the view server has an invalid parameter; answered with HTTP 400."""
+
+
+class ConfigWriteError(RangeBearingError, OSError):
+    """A config file cannot be written (permissions, read-only file system)."""
+
+
+class ServeError(RangeBearingError, OSError):
+    """The view's web server cannot listen on the address asked for."""
