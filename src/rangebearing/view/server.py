@@ -19,6 +19,7 @@ browser cannot change the thresholds or write the config.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import socket
@@ -68,7 +69,7 @@ class Handler(BaseHTTPRequestHandler):
     server: _Server
     server_version = "rangebearing-view"
 
-    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base class's name
+    def log_message(self, format: str, *args: Any) -> None:
         log.debug("%s %s", self.address_string(), format % args)
 
     # --- plumbing ----------------------------------------------------------------------------
@@ -119,15 +120,13 @@ class Handler(BaseHTTPRequestHandler):
             pass  # the browser went away
         except Exception as exc:  # never let a request take anything down with it
             log.exception("view: %s %s failed", self.command, self.path)
-            try:
+            with contextlib.suppress(OSError):
                 self._error(HTTPStatus.INTERNAL_SERVER_ERROR, f"{type(exc).__name__}: {exc}")
-            except OSError:
-                pass
 
-    def do_GET(self) -> None:  # noqa: N802 - the base class's name
+    def do_GET(self) -> None:
         self._dispatch(GET_ROUTES)
 
-    def do_POST(self) -> None:  # noqa: N802
+    def do_POST(self) -> None:
         self._dispatch(POST_ROUTES)
 
     def _body(self) -> Any:

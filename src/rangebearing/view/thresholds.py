@@ -65,7 +65,7 @@ def _hue_ranges(v: Any) -> HueRanges:
             raise ValueError(f"expected a [low, high] pair, got {r!r}")
         lo, hi = _integer(r[0], 0, 179), _integer(r[1], 0, 179)
         if lo > hi:
-            raise ValueError(f"low {lo} is above high {hi} (red wraps: give it as two ranges, e.g. [0, 10], [165, 179])")
+            raise ValueError(f"low {lo} is above high {hi} (a hue range that wraps is two: [0, 10], [165, 179])")
         out.append((lo, hi))
     return tuple(out)
 
