@@ -53,6 +53,10 @@ def _static_files() -> Dict[str, Tuple[bytes, str]]:
     return out
 
 
+class _Forbidden(RequestError):
+    """A request from another origin (answered 403)."""
+
+
 class _Server(ThreadingHTTPServer):
     daemon_threads = True  # a browser left open never holds up the exit
     hub: ViewHub
@@ -115,7 +119,7 @@ class Handler(BaseHTTPRequestHandler):
                 return
             route(self)
         except RequestError as exc:
-            self._error(HTTPStatus.BAD_REQUEST, str(exc))
+            self._error(HTTPStatus.FORBIDDEN if isinstance(exc, _Forbidden) else HTTPStatus.BAD_REQUEST, str(exc))
         except (BrokenPipeError, ConnectionResetError):
             pass  # the browser went away
         except Exception as exc:  # never let a request take anything down with it
@@ -136,7 +140,7 @@ class Handler(BaseHTTPRequestHandler):
             raise RequestError(f"expected Content-Type application/json, got {ctype or 'none'}")
         origin = self.headers.get("Origin")
         if origin and urlsplit(origin).netloc != self.headers.get("Host"):
-            raise RequestError(f"cross-origin request from {origin} refused")
+            raise _Forbidden(f"cross-origin request from {origin} refused")
         try:
             n = int(self.headers.get("Content-Length", ""))
         except ValueError:
@@ -276,7 +280,7 @@ class ViewServer:
     def start(self) -> ViewServer:
         """Start the encoder thread and serve in a background thread."""
         self.hub.start()
-        self._thread = threading.Thread(target=self._httpd.serve_forever, name="rangebearing-view", daemon=True)
+        self._thread = threading.Thread(target=self._httpd.serve_forever, args=(0.1,), name="rangebearing-view", daemon=True)
         self._thread.start()
         return self
 
