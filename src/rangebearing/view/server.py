@@ -280,7 +280,9 @@ class ViewServer:
     def start(self) -> ViewServer:
         """Start the encoder thread and serve in a background thread."""
         self.hub.start()
-        self._thread = threading.Thread(target=self._httpd.serve_forever, args=(0.1,), name="rangebearing-view", daemon=True)
+        self._thread = threading.Thread(
+            target=self._httpd.serve_forever, args=(0.1,), name="rangebearing-view", daemon=True
+        )
         self._thread.start()
         return self
 
