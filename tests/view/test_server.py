@@ -81,15 +81,15 @@ def test_mjpeg_stream_delivers_jpeg_frames(served) -> None:
     assert r.status == 200 and r.getheader("Content-Type").startswith("multipart/x-mixed-replace; boundary=")
     boundary = r.getheader("Content-Type").split("boundary=")[1].encode()
     images = []
+    assert r.readline().strip() == b"--" + boundary
     for _ in range(2):
-        assert r.readline().strip() == b"--" + boundary
         headers = {}
         while (line := r.readline().strip()) != b"":
             k, _, v = line.decode().partition(":")
             headers[k.lower()] = v.strip()
         assert headers["content-type"] == "image/jpeg"
         data = r.read(int(headers["content-length"]))
-        r.readline()
+        assert r.readline() == b"\r\n" and r.readline().strip() == b"--" + boundary  # the part ends at once
         images.append(cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR))
     conn.close()
     assert all(im.shape == (480, 640, 3) for im in images)

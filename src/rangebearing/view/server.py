@@ -165,6 +165,8 @@ class Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Type", f"multipart/x-mixed-replace; boundary={BOUNDARY.decode()}")
         self.send_header("Cache-Control", "no-store")
         self.end_headers()
+        # each part is followed at once by the next boundary: browsers show a part when its boundary arrives
+        self.wfile.write(b"--%s\r\n" % BOUNDARY)
         seq = 0
         with hub.viewer(layer):
             while not hub.closed:
@@ -174,8 +176,8 @@ class Handler(BaseHTTPRequestHandler):
                 seq = snap.seq
                 data = snap.masks_jpeg if layer == "masks" else snap.jpeg
                 if data:
-                    head = b"--%s\r\nContent-Type: image/jpeg\r\nContent-Length: %d\r\n\r\n" % (BOUNDARY, len(data))
-                    self.wfile.write(head + data + b"\r\n")
+                    head = b"Content-Type: image/jpeg\r\nContent-Length: %d\r\n\r\n" % len(data)
+                    self.wfile.write(head + data + b"\r\n--%s\r\n" % BOUNDARY)
                     self.wfile.flush()
 
     def frame(self) -> None:
