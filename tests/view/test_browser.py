@@ -55,7 +55,7 @@ def set_slider(pg, selector: str, value: int) -> None:
 
 
 def test_stream_shows_frames(page) -> None:
-    size = page.evaluate("[document.getElementById('stream').naturalWidth, document.getElementById('stream').naturalHeight]")
+    size = page.evaluate("(i => [i.naturalWidth, i.naturalHeight])(document.getElementById('stream'))")
     assert size == [640, 480]
     seq = int(page.get_attribute("body", "data-seq"))
     shot = page.locator("#stream").screenshot()
