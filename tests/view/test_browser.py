@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Iterator, List, Tuple
 
 import cv2
+import numpy as np
 import pytest
 
 from rangebearing.config import Config, load_config
@@ -91,11 +92,26 @@ def test_plot_puts_landmarks_at_the_measured_bearings(page) -> None:
     assert left["bearing"] > 0 > right["bearing"] and left["x"] < plotted["ox"] < right["x"]  # left is left
 
 
+def overlay_pixels(pg) -> int:
+    """Pixels of the stream drawn in the overlay's green (the clip itself has none)."""
+    img = cv2.imdecode(np.frombuffer(pg.locator("#stream").screenshot(), np.uint8), cv2.IMREAD_COLOR).astype(int)
+    b, g, r = img[:, :, 0], img[:, :, 1], img[:, :, 2]
+    return int(((g - r > 80) & (g - b > 80)).sum())
+
+
+def wait_frames(pg, n: int) -> None:
+    seq = int(pg.get_attribute("body", "data-seq"))
+    pg.wait_for_function(f"+document.body.dataset.seq >= {seq + n}", timeout=10000)
+
+
 def test_raising_s_min_hides_the_landmarks(page) -> None:
+    assert overlay_pixels(page) > 10  # boxes and labels drawn around both landmarks
     set_slider(page, "#s_min", 255)
     page.wait_for_function("document.body.dataset.sMin === '255'", timeout=10000)
     page.wait_for_function("document.querySelectorAll('#readings tbody tr').length === 0", timeout=10000)
     assert "s ≥ 255" in page.inner_text("#message")
+    wait_frames(page, 2)
+    assert overlay_pixels(page) == 0  # nothing detected, nothing drawn
     page.screenshot(path=str(SHOTS / "view-s-min-255.png"))
     set_slider(page, "#s_min", 90)
     page.wait_for_function("document.querySelectorAll('#readings tbody tr').length === 2", timeout=10000)
