@@ -80,9 +80,5 @@ class RequestError(RangeBearingError, ValueError):
     """A request to the view server has an invalid parameter; answered with HTTP 400."""
 
 
-class ConfigWriteError(RangeBearingError, OSError):
-    """A config file cannot be written (permissions, read-only file system)."""
-
-
 class ServeError(RangeBearingError, OSError):
     """The view's web server cannot listen on the address asked for."""

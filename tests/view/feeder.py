@@ -22,7 +22,7 @@ class Feeder:
         self.hub, self.cfg, self.fps = hub, cfg or Config(), fps
         self.files = sorted(p for p in Path(clip).iterdir() if p.suffix in (".jpg", ".png"))
         self.images: List[np.ndarray] = [cv2.imread(str(p)) for p in self.files]
-        self.pipe = Pipeline(self.cfg)
+        self.pipe = Pipeline(self.cfg.pipeline)
         self.frames = 0
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
@@ -35,7 +35,7 @@ class Feeder:
                 import dataclasses
 
                 self.cfg = dataclasses.replace(self.cfg, detection=new.apply(self.cfg.detection))
-                self.pipe = Pipeline(self.cfg)
+                self.pipe = Pipeline(self.cfg.pipeline)
             k = i % len(self.images)
             result = self.pipe.process(self.images[k])
             now = time.monotonic_ns()

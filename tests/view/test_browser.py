@@ -80,7 +80,7 @@ def test_plot_puts_landmarks_at_the_measured_bearings(page) -> None:
     rows = sorted(plotted["rows"], key=lambda r: r["bearing"])
     assert len(rows) == 2
     frame = rows[0]["frame"]
-    measured = Pipeline(Config(), track=False).process(cv2.imread(str(CLIP / frame))).landmarks
+    measured = Pipeline(Config().pipeline, track=False).process(cv2.imread(str(CLIP / frame))).landmarks
     for row, lm, truth in zip(rows, sorted(measured, key=lambda m: m.bearing_rad), truth_bearings(frame)):
         # the bearing the plot shows: the angle of the dot from straight up, positive to the left
         shown = math.atan2(plotted["ox"] - row["x"], plotted["oy"] - row["y"])

@@ -31,7 +31,7 @@ def make_hub(**kw) -> ViewHub:
 def test_no_viewer_no_work(frame: np.ndarray) -> None:
     hub = make_hub()
     try:
-        result = Pipeline(CFG).process(frame)
+        result = Pipeline(CFG.pipeline).process(frame)
         offered = 0
         for _ in range(50):
             now = time.monotonic_ns()
@@ -46,7 +46,7 @@ def test_no_viewer_no_work(frame: np.ndarray) -> None:
 def test_rate_is_capped(frame: np.ndarray) -> None:
     hub = make_hub(max_fps=10.0)
     try:
-        result = Pipeline(CFG).process(frame)
+        result = Pipeline(CFG.pipeline).process(frame)
         offered = 0
         with hub.viewer():
             t_end = time.monotonic_ns() + 500_000_000
@@ -68,7 +68,7 @@ def test_rate_is_capped(frame: np.ndarray) -> None:
 def test_masks_only_for_mask_viewers(frame: np.ndarray) -> None:
     hub = make_hub(max_fps=0)
     try:
-        result = Pipeline(CFG).process(frame)
+        result = Pipeline(CFG.pipeline).process(frame)
         with hub.viewer("masks"):
             hub.offer(time.monotonic_ns(), frame, "f", result, CFG.detection, {})
             snap = hub.wait(0, 2.0)
@@ -94,7 +94,7 @@ def test_thresholds_are_handed_over_once() -> None:
 def test_a_drawing_bug_does_not_stop_the_encoder(frame: np.ndarray, monkeypatch: pytest.MonkeyPatch) -> None:
     hub = make_hub(max_fps=0)
     try:
-        result = Pipeline(CFG).process(frame)
+        result = Pipeline(CFG.pipeline).process(frame)
         real = hub_mod.draw.overlay
         calls = []
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from rangebearing.config import load_config
-from rangebearing.errors import ConfigError, ConfigWriteError
+from rangebearing.errors import ConfigError, OutputError
 from rangebearing.view import save as save_mod
 from rangebearing.view.save import save_thresholds
 from rangebearing.view.thresholds import Thresholds
@@ -83,12 +83,12 @@ def test_failed_rename_leaves_the_old_file(tmp_path: Path, monkeypatch: pytest.M
         real(src, dst)
 
     monkeypatch.setattr(save_mod.os, "replace", replace)
-    with pytest.raises(ConfigWriteError, match="No space left"):
+    with pytest.raises(OutputError, match="No space left"):
         save_thresholds(path, NEW)
     assert path.read_text() == "detection:\n  s_min: 90\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.yaml", "c.yaml.bak"]  # the temp file removed
 
 
 def test_missing_file(tmp_path: Path) -> None:
-    with pytest.raises(ConfigWriteError, match="cannot read"):
+    with pytest.raises(OutputError, match="cannot read"):
         save_thresholds(tmp_path / "nope.yaml", NEW)

@@ -17,7 +17,7 @@ from typing import Any, Dict, List, Optional, Tuple, Union
 
 import yaml
 
-from ..errors import ConfigError, ConfigWriteError
+from ..errors import ConfigError, OutputError
 from .thresholds import KEYS, Thresholds
 
 _TOP = re.compile(r"^[^\s#]")
@@ -118,7 +118,7 @@ def save_thresholds(path: Union[str, Path], thresholds: Thresholds) -> Tuple[Pat
     ------
     ConfigError
         The file is not a valid config, or the new one would not be.
-    ConfigWriteError
+    OutputError
         The file or its backup cannot be read or written (permissions, read-only file system).
     """
     path = Path(path)
@@ -127,11 +127,11 @@ def save_thresholds(path: Union[str, Path], thresholds: Thresholds) -> Tuple[Pat
         old = path.read_bytes()
         mode = path.stat().st_mode & 0o7777
     except OSError as exc:
-        raise ConfigWriteError(f"cannot read {path}: {exc.strerror or exc}") from None
+        raise OutputError(f"cannot read {path}: {exc.strerror or exc}") from None
     new = updated_text(old.decode("utf-8"), thresholds, str(path))
     try:
         _atomic_write(backup, old, mode)
         _atomic_write(path, new.encode("utf-8"), mode)
     except OSError as exc:
-        raise ConfigWriteError(f"cannot write {exc.filename or path}: {exc.strerror or exc}") from None
+        raise OutputError(f"cannot write {exc.filename or path}: {exc.strerror or exc}") from None
     return path, backup

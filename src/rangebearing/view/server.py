@@ -30,7 +30,7 @@ from importlib import resources
 from typing import Any, Dict, Optional, Tuple
 from urllib.parse import parse_qs, urlsplit
 
-from ..errors import ConfigError, ConfigWriteError, RequestError, ServeError
+from ..errors import ConfigError, OutputError, RequestError, ServeError
 from . import thresholds as th
 from .hub import LAYERS, ViewHub
 from .save import save_thresholds
@@ -237,7 +237,7 @@ class Handler(BaseHTTPRequestHandler):
             path, backup = save_thresholds(hub.config_file, hub.thresholds)
         except ConfigError as exc:
             return self._error(HTTPStatus.CONFLICT, str(exc))
-        except ConfigWriteError as exc:
+        except OutputError as exc:
             return self._error(HTTPStatus.INTERNAL_SERVER_ERROR, str(exc))
         log.info("view: thresholds saved to %s (old file kept as %s)", path, backup)
         self._json(200, {"saved": str(path), "backup": str(backup), "thresholds": hub.thresholds.as_json()})
