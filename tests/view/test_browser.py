@@ -13,11 +13,10 @@ import cv2
 import numpy as np
 import pytest
 
-from rangebearing.config import Config, load_config
+from rangebearing.config import load_config
 from rangebearing.core.pipeline import Pipeline
-from rangebearing.view import Thresholds, ViewHub, ViewServer
 from tests.view.browser import browser_context
-from tests.view.feeder import Feeder
+from tests.view.processes import Served
 
 REPO = Path(__file__).resolve().parents[2]
 CLIP = REPO / "samples" / "clip"
@@ -30,13 +29,15 @@ def context() -> Iterator[object]:
 
 
 @pytest.fixture(scope="module")
-def view(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Tuple[str, Path]]:
+def view(context, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Tuple[str, Path]]:
+    """``rangebearing view`` on the bundled clip (paced at 4 fps, looping) with a copy of the default config."""
     cfg_path = tmp_path_factory.mktemp("view") / "rangebearing.yaml"
     shutil.copy(REPO / "config" / "rangebearing.yaml", cfg_path)
-    cfg = Config()
-    hub = ViewHub(Thresholds.of(cfg.detection), max_fps=10, config_file=str(cfg_path), hfov_rad=cfg.camera.hfov_rad)
-    with ViewServer(hub, "127.0.0.1", 0) as srv, Feeder(hub, CLIP, cfg, fps=4):
-        yield srv.url, cfg_path
+    served = Served(["view", "--config", str(cfg_path), "--source", str(CLIP), "--loop", "--fps", "4", "--port", "0"])
+    try:
+        yield served.url, cfg_path  # type: ignore[misc]
+    finally:
+        assert served.stop() == 0, "".join(served.log)
 
 
 @pytest.fixture
@@ -80,7 +81,8 @@ def test_plot_puts_landmarks_at_the_measured_bearings(page) -> None:
     rows = sorted(plotted["rows"], key=lambda r: r["bearing"])
     assert len(rows) == 2
     frame = rows[0]["frame"]
-    measured = Pipeline(Config().pipeline, track=False).process(cv2.imread(str(CLIP / frame))).landmarks
+    pipe = Pipeline(load_config(REPO / "config" / "rangebearing.yaml").pipeline, track=False)
+    measured = pipe.process(cv2.imread(str(CLIP / frame))).landmarks
     for row, lm, truth in zip(rows, sorted(measured, key=lambda m: m.bearing_rad), truth_bearings(frame)):
         # the bearing the plot shows: the angle of the dot from straight up, positive to the left
         shown = math.atan2(plotted["ox"] - row["x"], plotted["oy"] - row["y"])

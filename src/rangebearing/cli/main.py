@@ -30,6 +30,7 @@ COMMANDS: Dict[str, str] = {
     "synth": "render synthetic frames with exact ground truth",
     "intrinsics": "camera intrinsics and lens distortion from chessboard frames",
     "tune": "lock exposure and white balance and fit the colour thresholds to a landmark in view",
+    "view": "serve a live web page of what the camera sees, with threshold controls",
 }
 
 EXIT_ERROR = 1

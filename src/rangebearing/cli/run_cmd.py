@@ -6,7 +6,7 @@ import argparse
 import dataclasses
 import logging
 import sys
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from ..config import Config, check
 from ..daemon.loop import Daemon
@@ -17,6 +17,9 @@ from ..net.publisher import UdpPublisher
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
 from .common import add_config_arg, add_source_args, config_from_args, format_reading, source_from_args
+
+if TYPE_CHECKING:
+    from ..view.server import ViewServer
 
 log = logging.getLogger("rangebearing.run")
 
@@ -80,13 +83,32 @@ def run(args: argparse.Namespace) -> int:
     echo = None
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
-    daemon = Daemon(cfg, source_opener, publisher_for, Notifier(), reload=reloader(args), echo=echo)
-    daemon.install_signal_handlers()
-    dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)
-    if cfg.publish.multicast_group:
-        dests += f", multicast {cfg.publish.multicast_group}:{cfg.publish.multicast_port}"
-    log.info("starting: source %s, publishing to %s", cfg.source.kind, dests or "nowhere")
-    return daemon.run()
+    view = start_view_for(cfg, cfg.daemon.view_host, cfg.daemon.view_port, cfg.daemon.view_fps, args.config)
+    try:
+        daemon = Daemon(
+            cfg, source_opener, publisher_for, Notifier(), reload=reloader(args), echo=echo,
+            view=view.hub if view else None,
+        )
+        daemon.install_signal_handlers()
+        dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)
+        if cfg.publish.multicast_group:
+            dests += f", multicast {cfg.publish.multicast_group}:{cfg.publish.multicast_port}"
+        log.info("starting: source %s, publishing to %s", cfg.source.kind, dests or "nowhere")
+        return daemon.run()
+    finally:
+        if view is not None:
+            view.close()
+
+
+def start_view_for(
+    cfg: Config, host: str, port: int, max_fps: float, config_file: Optional[str]
+) -> Optional[ViewServer]:
+    """The live web page for this config, or None when ``port`` is 0 (off)."""
+    if not port:
+        return None
+    from ..view.app import start_view  # the HTTP server is loaded only when asked for
+
+    return start_view(cfg.detection, cfg.camera, cfg.landmark, host, port, max_fps, config_file)
 
 
 def _echo_json(payload: bytes) -> None:

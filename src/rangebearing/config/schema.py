@@ -60,6 +60,9 @@ class DaemonConfig:
 
     status_interval_s: float = 5.0
     echo: bool = False
+    view_port: int = 0  # the live web page (docs/view.md); 0 = off
+    view_host: str = "127.0.0.1"  # loopback: reach it through an SSH tunnel
+    view_fps: float = 10.0  # frames drawn and sent per second while a browser watches
 
 
 @frozen
@@ -162,5 +165,14 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "multicast_interface": ck.string,
         },
     ),
-    "daemon": (DaemonConfig, {"status_interval_s": ck.number(above=0, hi=3600), "echo": ck.boolean}),
+    "daemon": (
+        DaemonConfig,
+        {
+            "status_interval_s": ck.number(above=0, hi=3600),
+            "echo": ck.boolean,
+            "view_port": ck.number(0, 65535, integer=True),
+            "view_host": ck.string,
+            "view_fps": ck.number(0.1, 60),
+        },
+    ),
 }

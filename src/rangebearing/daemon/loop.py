@@ -11,11 +11,12 @@ config that the injected ``reload`` returns, between frames.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import signal
 import threading
 import time
-from typing import Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Dict, Optional
 
 from ..config import Config
 from ..core.pipeline import Pipeline
@@ -25,6 +26,9 @@ from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource
 from .housekeeping import Housekeeping, ServiceManager
 from .stats import LoopStats, Summary
+
+if TYPE_CHECKING:
+    from ..view.hub import ViewHub
 
 log = logging.getLogger("rangebearing.daemon")
 
@@ -53,6 +57,10 @@ class Daemon:
         ``--source`` wins over the file's). ``None``: SIGHUP is logged and ignored.
     echo : callable, optional
         Called with every datagram sent (``--echo`` prints it).
+    view : ViewHub, optional
+        The live web page (:mod:`rangebearing.view`): offered a frame only while
+        a browser watches, at its capped rate; its threshold changes are applied
+        between frames.
     """
 
     def __init__(
@@ -63,12 +71,14 @@ class Daemon:
         notifier: ServiceManager,
         reload: Optional[Reload] = None,
         echo: Optional[Echo] = None,
+        view: Optional[ViewHub] = None,
     ) -> None:
         self.cfg = cfg
         self._open_source = open_source
         self._open_publisher = open_publisher
         self._reload_config = reload
         self.echo = echo
+        self.view = view
         self.stats = LoopStats()
         self.house = Housekeeping(notifier, self.summary, cfg.daemon.status_interval_s)
         self._stop = threading.Event()
@@ -119,6 +129,8 @@ class Daemon:
         while not self._stop.is_set():
             if self._reload.is_set():
                 self._do_reload()
+            if self.view is not None:
+                self._view_thresholds()
             t_read = clock()
             try:
                 frame = self._source.read()  # type: ignore[union-attr]
@@ -140,7 +152,21 @@ class Daemon:
             self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages)
             self._echo(payload)
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
+            if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
+                self.view.offer(t2, frame.image, frame.name, result, self.cfg.detection, self._view_status())
         return 0
+
+    def _view_status(self) -> Dict[str, Any]:
+        return dataclasses.asdict(self.summary())
+
+    def _view_thresholds(self) -> None:
+        """Detect with the thresholds a browser set, from this frame on (a new pipeline: tracks restart)."""
+        new = self.view.take_thresholds()  # type: ignore[union-attr]
+        if new is None:
+            return
+        self.cfg = dataclasses.replace(self.cfg, detection=new.apply(self.cfg.detection))
+        self._pipe = Pipeline(self.cfg.pipeline)
+        log.info("thresholds set from the view page: %s (not saved)", new.as_json())
 
     def _echo(self, payload: bytes) -> None:
         """Show a sent reading; a closed terminal or pipe stops the echo, not the daemon."""
@@ -180,7 +206,13 @@ class Daemon:
             self._publisher.close()  # type: ignore[union-attr]
             if new.pipeline != self.cfg.pipeline:
                 self._pipe = Pipeline(new.pipeline)
+            if new.daemon.view_port != self.cfg.daemon.view_port or new.daemon.view_host != self.cfg.daemon.view_host:
+                log.warning("daemon.view_port / view_host changes take effect at the next start")
             self._publisher, self.cfg = new_pub, new
+            if self.view is not None:
+                from ..view.thresholds import Thresholds
+
+                self.view.reset_thresholds(Thresholds.of(new.detection))
             log.info("config reloaded")
         finally:
             self.house.reloaded()
