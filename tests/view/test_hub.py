@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 
@@ -11,6 +12,7 @@ import pytest
 
 from rangebearing.config import Config
 from rangebearing.core.pipeline import Pipeline
+from rangebearing.core.types import FrameResult
 from rangebearing.view import Thresholds, ViewHub
 from rangebearing.view import hub as hub_mod
 
@@ -111,5 +113,20 @@ def test_a_drawing_bug_does_not_stop_the_encoder(frame: np.ndarray, monkeypatch:
             hub.offer(time.monotonic_ns(), frame, "b", result, CFG.detection, {})
             snap = hub.wait(0, 2.0)
         assert snap is not None and json.loads(snap.state)["frame"]["name"] == "b"
+    finally:
+        hub.close()
+
+
+def test_numpy_numbers_in_a_reading_make_valid_json(frame: np.ndarray) -> None:
+    hub = make_hub(max_fps=0)
+    try:
+        lm = Pipeline(CFG.pipeline).process(frame).landmarks[0]
+        odd = dataclasses.replace(lm, bbox_px=tuple(np.int64(v) for v in lm.bbox_px), range_m=np.float32(lm.range_m))
+        with hub.viewer():
+            hub.offer(time.monotonic_ns(), frame, "f", FrameResult((odd,)), CFG.detection, {"n": np.int64(3)})
+            snap = hub.wait(0, 2.0)
+        assert snap is not None
+        state = json.loads(snap.state)
+        assert state["landmarks"][0]["bbox_px"] == [int(v) for v in lm.bbox_px] and state["stats"] == {"n": 3}
     finally:
         hub.close()

@@ -243,4 +243,11 @@ class ViewHub:
             "hfov_rad": self.hfov_rad,
             "config_file": self.config_file,
         }
-        return Snapshot(state["seq"], jpeg, masks, json.dumps(state).encode("utf-8"))  # type: ignore[arg-type]
+        return Snapshot(state["seq"], jpeg, masks, json.dumps(state, default=_plain).encode("utf-8"))  # type: ignore[arg-type]
+
+
+def _plain(o: Any) -> Any:
+    """numpy scalars and arrays (which the pipeline may hand out) as plain JSON numbers and lists."""
+    if isinstance(o, (np.generic, np.ndarray)):
+        return o.tolist()
+    raise TypeError(f"{type(o).__name__} is not JSON serialisable")
