@@ -6,7 +6,7 @@ These run on the view's encoder thread, never in the capture loop.
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, Optional
+from typing import Any, Dict, Optional, Tuple
 
 import cv2
 import numpy as np
@@ -23,16 +23,19 @@ def _text(img: np.ndarray, label: str, org: tuple, colour: tuple, scale: float =
     cv2.putText(img, label, org, FONT, scale, colour, 1, cv2.LINE_AA)
 
 
-def label(lm: Landmark) -> str:
-    """``#3 0.412 m +12.3°`` with ``±σ`` when the pipeline measured one (degrees as ``deg`` for OpenCV's font)."""
+def label(lm: Landmark) -> Tuple[str, str]:
+    """Two lines: ``#3 0.412 m +-4 mm`` and ``+12.3 deg +-0.05`` (the track id and σ when known).
+
+    OpenCV's Hershey fonts have no ``±`` or ``°``.
+    """
     tid = f"#{lm.track_id} " if lm.track_id >= 0 else ""
-    rng = f"{lm.range_m:.3f}"
+    rng = f"{tid}{lm.range_m:.3f} m"
     if lm.range_sigma_m > 0:
-        rng += f"+-{lm.range_sigma_m * 1000:.0f}mm"
-    brg = f"{math.degrees(lm.bearing_rad):+.1f}"
+        rng += f" +-{lm.range_sigma_m * 1000:.0f} mm"
+    brg = f"{math.degrees(lm.bearing_rad):+.1f} deg"
     if lm.bearing_sigma_rad > 0:
-        brg += f"+-{math.degrees(lm.bearing_sigma_rad):.2f}"
-    return f"{tid}{rng} m {brg} deg"
+        brg += f" +-{math.degrees(lm.bearing_sigma_rad):.2f}"
+    return rng, brg
 
 
 def overlay(frame_bgr: np.ndarray, result: FrameResult, band_ratio: float = 15.0 / 55.0) -> np.ndarray:
@@ -41,12 +44,12 @@ def overlay(frame_bgr: np.ndarray, result: FrameResult, band_ratio: float = 15.0
     The band boxes are drawn around each centroid, as wide as the landmark and
     as tall as a band (``band_ratio`` = band height / band spacing, times the
     centroid distance).
-    Landmarks outside the calibrated envelope are grey, partly hidden ones yellow.
+    Landmarks outside the calibrated envelope are grey, partly hidden ones (``visible`` < 0.9) yellow.
     """
     out = frame_bgr.copy()
     for lm in result.landmarks:
         x, y, w, h = lm.bbox_px
-        colour = GREY if not lm.in_envelope else (YELLOW if lm.visible < 0.999 else GREEN)
+        colour = GREY if not lm.in_envelope else (YELLOW if lm.visible < 0.9 else GREEN)
         cv2.rectangle(out, (x, y), (x + w, y + h), colour, 1)
         half_w, half_h = lm.width_px / 2.0, max(1.0, lm.l_px * band_ratio / 2.0)
         for (cx, cy), c in ((lm.red_xy_px, RED), (lm.blue_xy_px, BLUE)):
@@ -56,8 +59,10 @@ def overlay(frame_bgr: np.ndarray, result: FrameResult, band_ratio: float = 15.0
             cv2.drawMarker(out, (round(cx), round(cy)), c, cv2.MARKER_CROSS, 9, 1)
         (rx, ry), (bx, by) = lm.red_xy_px, lm.blue_xy_px
         cv2.line(out, (round(rx), round(ry)), (round(bx), round(by)), colour, 1)
-        ty = y - 5 if y > 14 else y + h + 14
-        _text(out, label(lm), (x, ty), colour)
+        top, bottom = label(lm)
+        ty = y - 19 if y > 30 else y + h + 14
+        _text(out, top, (x, ty), colour)
+        _text(out, bottom, (x, ty + 14), colour)
     return out
 
 

@@ -69,8 +69,9 @@ function drawPlot(state) {
       const r0 = Math.max(0, lm.range_m - lm.range_sigma_m) * s.pxPerM;
       const r1 = (lm.range_m + lm.range_sigma_m) * s.pxPerM;
       const a0 = arcAngle(lm.bearing_rad + lm.bearing_sigma_rad), a1 = arcAngle(lm.bearing_rad - lm.bearing_sigma_rad);
-      g.fillStyle = "rgba(76, 217, 100, 0.28)";
-      g.beginPath(); g.arc(s.ox, s.oy, r1, a0, a1); g.arc(s.ox, s.oy, r0, a1, a0, true); g.closePath(); g.fill();
+      g.fillStyle = "rgba(76, 217, 100, 0.28)"; g.strokeStyle = colour;
+      g.beginPath(); g.arc(s.ox, s.oy, r1, a0, a1); g.arc(s.ox, s.oy, r0, a1, a0, true); g.closePath();
+      g.fill(); g.stroke();
     }
     g.fillStyle = colour;
     g.beginPath(); g.arc(x, y, 4, 0, 2 * Math.PI); g.fill();
