@@ -17,6 +17,7 @@ import yaml
 
 from ..errors import ConfigError
 from . import checks as ck
+from .camera_model import PRESET_KEYS, split_camera
 from .schema import MAX_CAPTURE_BUDGET_S, SCHEMA, Config
 from .yaml_safe import load_yaml
 
@@ -30,6 +31,11 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
     if not isinstance(data, Mapping):
         raise ConfigError([f"top level must be a mapping of sections, got {type(data).__name__}"], source)
     sections: Dict[str, Any] = {}
+    cam_raw = data.get("camera")
+    if isinstance(cam_raw, Mapping) and any(k in cam_raw for k in PRESET_KEYS):  # camera.model and its crops
+        preset, rest = split_camera(cam_raw, data.get("source"), base.camera, problems)
+        base = dataclasses.replace(base, camera=preset)
+        data = {**data, "camera": rest}
     for name in data:
         if name not in SCHEMA:
             problems.append(f"unknown section {ck.show(name)} (known: {', '.join(SCHEMA)})")
@@ -46,7 +52,8 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
         values: Dict[str, Any] = {}
         for key, val in raw.items():
             if key not in checks:
-                problems.append(f"{name}.{_key(key)}: unknown key (known: {', '.join(checks)})")
+                known = [*checks, *PRESET_KEYS] if name == "camera" else list(checks)
+                problems.append(f"{name}.{_key(key)}: unknown key (known: {', '.join(known)})")
                 continue
             try:
                 values[key] = checks[key](val)
