@@ -9,14 +9,22 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 import cv2
 
 from ..config import check
 from ..errors import FrameError, SourceError
 from ..sources.factory import open_source
-from .common import add_config_arg, add_source_args, config_from_args, source_from_args
+from .common import (
+    add_config_arg,
+    add_quiet_arg,
+    add_source_args,
+    config_from_args,
+    progress,
+    quiet_or_auto,
+    source_from_args,
+)
 
 
 def register(sub: Any) -> None:
@@ -33,6 +41,7 @@ def register(sub: Any) -> None:
     p.add_argument("--format", choices=("png", "jpg"), default="png", help="image format (default png, lossless)")
     add_config_arg(p)
     add_source_args(p)
+    add_quiet_arg(p)
     p.set_defaults(func=run)
 
 
@@ -51,10 +60,12 @@ def run(args: argparse.Namespace) -> int:
     source = open_source(src_cfg, cfg.camera, sleep=stop.wait)
     n = bad = 0
     t_end = time.monotonic() + args.seconds if args.seconds else None
-    try:
+
+    def frames() -> Iterator[Any]:
+        nonlocal bad
         while not stop.is_set() and (args.frames is None or n < args.frames):
             if t_end is not None and time.monotonic() >= t_end:
-                break
+                return
             try:
                 frame = source.read()
             except FrameError as exc:
@@ -62,7 +73,11 @@ def run(args: argparse.Namespace) -> int:
                 print(f"bad frame skipped: {exc}", file=sys.stderr)
                 continue
             if frame is None:
-                break
+                return
+            yield frame
+
+    try:
+        for frame in progress(frames(), args.frames, "record", quiet_or_auto(args)):
             path = out / f"{n:06d}.{args.format}"
             if not cv2.imwrite(str(path), frame.image):
                 raise SourceError(f"cannot write {path}")
@@ -70,5 +85,6 @@ def run(args: argparse.Namespace) -> int:
         dropped = source.dropped
     finally:
         source.close()
-    print(f"recorded {n} frames to {out} ({dropped} dropped by the source, {bad} bad)")
+    why = " (stopped by a signal)" if stop.is_set() else ""
+    print(f"recorded {n} frames to {out}{why} ({dropped} dropped by the source, {bad} bad)")
     return 0

@@ -57,9 +57,13 @@ def run(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise OutputError(f"--out: cannot write {args.out}: {exc.strerror or exc}") from None
     evaluated: List[Tuple[str, Tuple[Landmark, ...], list]] = []
-    bad = 0
+    bad = done = 0
+    interrupted = False
+    # the bar shares the terminal with the per-frame lines only when those go elsewhere (-q, or piped)
+    bar = None if (args.quiet or not sys.stdout.isatty()) else False
     try:
-        for name, image in progress(iter_recorded(path), count_recorded(path), "replay"):
+        for name, image in progress(iter_recorded(path), count_recorded(path), "replay", bar):
+            done += 1
             try:
                 if image is None:
                     raise FrameError("unreadable image")
@@ -84,6 +88,10 @@ def run(args: argparse.Namespace) -> int:
                     raise OutputError(f"--annotate: cannot write {ann_dir / f'{stem}.png'}")
             if truth is not None:
                 evaluated.append((name, result.landmarks, truth.get(name, [])))
+    except KeyboardInterrupt:
+        interrupted = True
+        what = f"; {args.out} holds them" if args.out else ""
+        print(f"\nreplay: interrupted after {done} frames{what}", file=sys.stderr)
     finally:
         if out:
             out.close()
@@ -93,5 +101,5 @@ def run(args: argparse.Namespace) -> int:
         if not evaluated:
             raise SourceError(f"no frames of {path} could be evaluated")
         report, _ = accuracy(evaluated)
-        print(format_report(report))
-    return 0
+        print(format_report(report) + (f"\n(the first {len(evaluated)} frames only)" if interrupted else ""))
+    return 130 if interrupted else 0

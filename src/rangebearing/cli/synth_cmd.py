@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import sys
 import time
-from typing import Any, Tuple
+from typing import Any, Iterator, Tuple
 
 from ..core.types import CameraIntrinsics
 from ..errors import OutputError
 from ..synth.dataset import CAMERA_FILE, FORMATS, TRUTH_FILE, write_dataset
 from ..synth.presets import PRESET_HELP, PRESETS
+from .common import add_quiet_arg, progress, quiet_or_auto
 
 
 def _size(text: str) -> Tuple[int, int]:
@@ -84,6 +86,7 @@ def register(subparsers: Any) -> None:
         "(with '=' when k1 is negative); default none",
     )
     p.add_argument("--overwrite", action="store_true", help="replace frames and truth.csv already in DIR")
+    add_quiet_arg(p)
     p.set_defaults(func=run)
 
 
@@ -94,12 +97,24 @@ def run(args: argparse.Namespace) -> int:
     if args.distortion is not None:
         camera = dataclasses.replace(camera, distortion=(*args.distortion, 0.0, 0.0, 0.0))
     start = time.perf_counter()
+    done = [0]
+
+    def counted(items: Iterator[Any]) -> Iterator[Any]:
+        for item in progress(items, args.frames, "synth", quiet_or_auto(args)):
+            yield item
+            done[0] += 1
+
     try:
         truth = write_dataset(
-            args.out, args.frames, args.seed, args.preset, args.fmt, args.jpeg_quality, camera, overwrite=args.overwrite
+            args.out, args.frames, args.seed, args.preset, args.fmt, args.jpeg_quality, camera,
+            overwrite=args.overwrite, wrap=counted,
         )
     except FileExistsError as exc:
         raise OutputError(f"{exc} (--overwrite replaces them)") from None
+    except KeyboardInterrupt:
+        print(f"\nsynth: interrupted after {done[0]} of {args.frames} frames; {TRUTH_FILE} and {CAMERA_FILE} "
+              f"in {args.out} cover exactly those", file=sys.stderr)
+        return 130
     seconds = time.perf_counter() - start
     with_landmark = len({row.frame for row in truth})
     print(

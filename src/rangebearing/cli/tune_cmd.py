@@ -140,7 +140,12 @@ def run(args: argparse.Namespace) -> int:
     try:
         if callable(getattr(source, "set_controls", None)):
             read_frames(source, max(1, args.settle))
-            locked = lock_controls(source.metadata)  # type: ignore[attr-defined]
+            metadata = source.metadata  # type: ignore[attr-defined]
+            locked = lock_controls(metadata)
+            if metadata.get("ScalerCrop"):
+                crop = list(metadata["ScalerCrop"])
+                print(f"the frames show the sensor's {crop} (ScalerCrop): with camera.model, "
+                      f"set camera.scaler_crop: {crop}")
             source.set_controls(locked)  # type: ignore[attr-defined]
             read_frames(source, LATENCY_FRAMES)
             print("locked: " + ", ".join(f"{k} {v}" for k, v in locked.items()))

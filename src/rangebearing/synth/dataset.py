@@ -11,7 +11,7 @@ import dataclasses
 import os
 import re
 from pathlib import Path
-from typing import Iterator, List, Tuple, Union
+from typing import Any, Callable, Iterator, List, Optional, Tuple, Union
 
 import cv2
 import numpy as np
@@ -114,9 +114,15 @@ def camera_yaml(camera: CameraIntrinsics) -> str:
 
 def write_dataset(out_dir: Union[str, os.PathLike], frames: int, seed: int,
                   preset: str = "paper", fmt: str = "png", jpeg_quality: int = 90,
-                  camera: CameraIntrinsics = DEFAULT_CAMERA, overwrite: bool = False
+                  camera: CameraIntrinsics = DEFAULT_CAMERA, overwrite: bool = False,
+                  wrap: Optional[Callable[[Iterator[Any]], Iterator[Any]]] = None,
                   ) -> List[TruthRow]:
     """Write frames, ``truth.csv`` and ``camera.yaml`` into ``out_dir``; return the truth.
+
+    ``wrap`` wraps the frame iterator (a progress bar). Each frame file appears
+    whole (written aside, then renamed), and ``truth.csv`` is written however
+    the loop ends, so an interrupted run (KeyboardInterrupt, re-raised) leaves
+    frames ``0..n-1`` with their truth, a consistent smaller dataset.
 
     Raises
     ------
@@ -138,9 +144,16 @@ def write_dataset(out_dir: Union[str, os.PathLike], frames: int, seed: int,
     for p in stale:
         p.unlink()
     truth: List[TruthRow] = []
-    for name, image, rows in _frames(frames, seed, preset, camera, fmt):
-        (out / name).write_bytes(_encode(image, fmt, jpeg_quality))
-        truth.extend(rows)
-    write_truth(out / TRUTH_FILE, truth)
-    (out / CAMERA_FILE).write_text(camera_yaml(camera), encoding="utf-8")
+    items = _frames(frames, seed, preset, camera, fmt)
+    try:
+        for name, image, rows in wrap(items) if wrap else items:
+            tmp = out / f".{name}.part"
+            tmp.write_bytes(_encode(image, fmt, jpeg_quality))
+            os.replace(tmp, out / name)
+            truth.extend(rows)
+    finally:
+        for part in out.glob(".*.part"):
+            part.unlink()
+        write_truth(out / TRUTH_FILE, truth)
+        (out / CAMERA_FILE).write_text(camera_yaml(camera), encoding="utf-8")
     return truth
