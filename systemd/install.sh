@@ -19,7 +19,7 @@ CONFIG=$ETC_DIR/config.yaml
 UNIT_DIR=/etc/systemd/system
 UNIT=rangebearing.service
 SERVICE_USER=rangebearing
-APT_PACKAGES="python3-picamera2 python3-opencv python3-numpy python3-yaml python3-venv"
+APT_PACKAGES="python3-picamera2 python3-opencv python3-numpy python3-yaml python3-tqdm python3-venv"
 
 # The checkout this script lives in (systemd/..).
 SRC_DIR=$(CDPATH='' cd -- "$(dirname -- "$0")/.." && pwd)

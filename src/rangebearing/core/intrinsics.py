@@ -98,11 +98,11 @@ def coverage_problems(views: Sequence[np.ndarray], obj: np.ndarray, size: Tuple[
     cells = set(zip(np.clip(pts[:, 0] * 4 // w, 0, 3).astype(int), np.clip(pts[:, 1] * 4 // h, 0, 3).astype(int)))
     if len(cells) < MIN_CELLS_FRAC * 16:
         empty = sorted({(i, j) for i in range(4) for j in range(4)} - cells)
-        names = ", ".join(f"{'top' if j < 2 else 'bottom'}-{'left' if i < 2 else 'right'}" for i, j in empty[:4])
+        names = ", ".join(sorted({f"{'top' if j < 2 else 'bottom'}-{'left' if i < 2 else 'right'}" for i, j in empty}))
         problems.append(
             f"corners not spread over the image: {len(cells)} of 16 cells of a 4×4 grid hold a corner "
             f"(need {math.ceil(MIN_CELLS_FRAC * 16)}); show the board near the frame's edges and corners "
-            f"(empty cells include {names})"
+            f"(nothing in the {names} part)"
         )
     tilts = [_tilt(v, obj, size) for v in views]
     tilted = [(t, az) for t, az in tilts if t >= MIN_TILT_DEG]
