@@ -50,10 +50,13 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
             sections[name] = current
             continue
         values: Dict[str, Any] = {}
+        listed = False  # the known keys are listed once per section: a misplaced block would repeat them
         for key, val in raw.items():
             if key not in checks:
                 known = [*checks, *PRESET_KEYS] if name == "camera" else list(checks)
-                problems.append(f"{name}.{_key(key)}: unknown key (known: {', '.join(known)})")
+                hint = "known keys above" if listed else f"known: {', '.join(known)}"
+                problems.append(f"{name}.{_key(key)}: unknown key ({hint})")
+                listed = True
                 continue
             try:
                 values[key] = checks[key](val)
