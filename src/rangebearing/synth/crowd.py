@@ -1,4 +1,4 @@
-"""Presets with several Zumo-like robots: ``occlusion``, ``crowd`` and ``far``.
+"""Presets with Zumo-like robots: ``occlusion``, ``crowd``, ``far`` and ``lighting``.
 
 ``occlusion``  2–4 robots, 0.2–1.6 m; one is drawn right behind another (its
                landmark's image offset by 0–1.2 half-widths, so from wholly
@@ -7,6 +7,9 @@
 ``crowd``      5–8 robots, 0.2–1.8 m, landmarks allowed past the frame edges.
 ``far``        one robot, 0.15–2.0 m (log-uniform), anywhere it is wholly in
                view, hard rooms and light.
+``lighting``   1–3 robots apart in the image, 0.2–1.5 m, each frame under one of
+               :data:`.looks.LIGHT_KINDS` (dim, bright, warm, cool, coloured,
+               spotlit, backlit, normal).
 
 Which landmark hides which is left to the geometry; the truth measures it.
 """
@@ -22,7 +25,7 @@ import numpy as np
 from ..core.types import CameraIntrinsics
 from . import looks
 from . import sampling as d
-from .robots import apart, left_to_right, partner, robot, scatter, wall_behind
+from .robots import apart, landmark_half_angle, left_to_right, partner, robot, scatter, wall_behind
 from .scene import Box, LandmarkPose, Scene
 
 BOX_COLOURS = ((0.55, 0.42, 0.28), (0.62, 0.60, 0.56), (0.30, 0.30, 0.32), (0.70, 0.66, 0.55))
@@ -111,3 +114,32 @@ def far_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
             scene = dataclasses.replace(base, landmarks=(lm,))
             return looks.finish(rng, wall_behind(scene, rng, 0.3, 1.5, 0.25), kind)
     raise d.give_up("far", camera)
+
+
+def _apart_in_image(scene: Scene, lm: LandmarkPose, placed: List[LandmarkPose]) -> bool:
+    a = landmark_half_angle(scene, lm.range_m)
+    return all(abs(lm.bearing_rad - o.bearing_rad) > 1.5 * (a + landmark_half_angle(scene, o.range_m))
+               for o in placed)
+
+
+def lighting_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
+    """One ``lighting`` frame: 1–3 robots apart in the image under one of the light kinds."""
+    kind = looks.LIGHT_KINDS[int(rng.integers(len(looks.LIGHT_KINDS)))]
+    n = int(rng.integers(1, 4))
+    base = looks.base_scene(rng, camera, kind, camera_height=(0.095, 0.105))
+    for _ in range(300):
+        placed: List[LandmarkPose] = []
+        for _ in range(60):
+            if len(placed) == n:
+                break
+            r = d.log_uniform(rng, 0.2, 1.5)
+            lo, hi = d.bearing_limits(camera, r, base.geometry.radius_m)
+            if lo >= hi:
+                continue
+            lm = robot(rng, r, d.uniform(rng, lo, hi))
+            if d.in_view(base, lm) and apart(lm, placed) and _apart_in_image(base, lm, placed):
+                placed.append(lm)
+        if len(placed) == n:
+            scene = dataclasses.replace(base, landmarks=left_to_right(placed))
+            return looks.finish(rng, wall_behind(scene, rng, 0.3, 1.2, 0.15), kind)
+    raise d.give_up("lighting", camera)

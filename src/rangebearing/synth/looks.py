@@ -58,7 +58,7 @@ def lighting(rng: np.random.Generator, kind: str) -> Lighting:
     amb_colour: RGB = (1.0, 1.0, 1.0)
     gloss = u(0.03, 0.12)
     if kind == "dim":
-        k = u(0.04, 0.15)
+        k = u(0.06, 0.2)
         colour, amb_colour = _scaled(colour, k), _scaled(amb_colour, k)
     elif kind == "bright":
         ambient = u(0.15, 0.3)
@@ -97,7 +97,8 @@ def imaging(rng: np.random.Generator, kind: str) -> Imaging:
     glare = d.uniform(rng, 0.02, 0.05) if kind == "backlit" else d.uniform(rng, 0.003, 0.012)
     return Imaging(blur_sigma_px=d.uniform(rng, 0.3, 0.9), read_noise=d.uniform(rng, 0.002, 0.005),
                    shot_noise=d.uniform(rng, 0.0003, 0.001), auto_exposure=True,
-                   ae_target=d.uniform(rng, 0.14, 0.2), ae_error=err, bayer=True, glare=glare)
+                   ae_target=d.uniform(rng, 0.14, 0.2), ae_error=err, bayer=True, glare=glare,
+                   edge_supersample=2)
 
 
 def base_scene(rng: np.random.Generator, camera: CameraIntrinsics, kind: str,

@@ -17,6 +17,10 @@ an auto-exposed Bayer camera:
                boxes, mats, posters and objects; one frame in eight empty.
 ``crowd``      5–8 robots, some cut by the frame edges.
 ``far``        one robot 0.15–2.0 m anywhere wholly in view, any light.
+``lighting``   1–3 robots under dim, bright, warm, cool, coloured, spotlit or
+               backlit light.
+``crowd-moving`` 4–6 robots driving and crossing at 30 fps, each with its
+               ``robot_id`` (see :mod:`.motion`).
 """
 
 from __future__ import annotations
@@ -34,11 +38,14 @@ from ..errors import SceneError
 from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
-from .crowd import crowd_scene, far_scene, occlusion_scene
+from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
+from .motion import crowd_sequence
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
 from .touching import touching_scene
 
-PRESETS = ("paper", "wide", "clutter", "multi", "sample", "occlusion", "touching", "crowd", "far")
+ORIGINAL_PRESETS = ("paper", "wide", "clutter", "multi", "sample")
+CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving")
+PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS
 SAMPLE_FPS = 30.0
 PRESET_HELP = {
     "paper": "one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg",
@@ -51,6 +58,9 @@ PRESET_HELP = {
                 "1 frame in 8 empty",
     "crowd": "5-8 robots in view, some cut by the frame edges",
     "far": "one robot 0.15-2.0 m over the whole field of view, any light",
+    "lighting": "1-3 robots under dim, bright, warm, cool, coloured, spotlit or backlit light",
+    "crowd-moving": "4-6 robots driving about and crossing each other at 30 fps; truth.csv's "
+                    "robot column keeps each robot's identity",
 }
 
 
@@ -155,7 +165,7 @@ def sample_scene(base: Scene, paths: Tuple[Wander, ...], t_s: float) -> Scene:
 
 
 _NEWER = {"occlusion": occlusion_scene, "touching": touching_scene, "crowd": crowd_scene,
-          "far": far_scene}
+          "far": far_scene, "lighting": lighting_scene}
 
 
 def random_scene(rng: np.random.Generator, preset: str,
@@ -189,12 +199,18 @@ def random_scene(rng: np.random.Generator, preset: str,
         return sample_scene(base, paths, d.uniform(rng, 0.0, 60.0))
     if preset in _NEWER:
         return _NEWER[preset](rng, camera)
+    if preset == "crowd-moving":
+        return next(crowd_sequence(rng, 1, camera))
     raise SceneError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
 
 
 def scene_sequence(rng: np.random.Generator, preset: str, frames: int,
                    camera: CameraIntrinsics = DEFAULT_CAMERA) -> Iterator[Scene]:
-    """``frames`` scenes: independent draws, or consecutive 30 fps moments for ``sample``."""
+    """``frames`` scenes: independent draws, or consecutive 30 fps moments for
+    ``sample`` and ``crowd-moving``."""
+    if preset == "crowd-moving":
+        yield from crowd_sequence(rng, frames, camera)
+        return
     if preset != "sample":
         for _ in range(frames):
             yield random_scene(rng, preset, camera)

@@ -103,6 +103,8 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
     dx, dy = grid.x, -grid.y
     shade = Shader.from_scene(scene)
     prims = primitives(scene)
+    if not shade.plain:  # nearest first: hidden surfaces fail the depth test before shading
+        prims.sort(key=lambda p: p.extent()[4])
     hits = trace_background(dx, dy, scene, shade)
     rects: List[Optional[Rect]] = [_rect_of(scene, p) for p in prims]
     for prim, rect in zip(prims, rects):
@@ -116,18 +118,32 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
     if supersample <= 1:
         return out
     flag = _edges(hits.ident)
+    near_landmark = np.zeros_like(flag)
     for prim, rect in zip(prims, rects):
-        # a far landmark's bands may be thinner than a pixel: take its whole extent
         if isinstance(prim, Cyl) and len(prim.bounds) > 1 and rect is not None:
             r0, r1, c0, c1 = rect
+            # a far landmark's bands may be thinner than a pixel: take its whole extent
             if (r1 - r0) * (c1 - c0) <= SMALL_LANDMARK_PX:
                 flag[r0:r1, c0:c1] = True
+            near_landmark[r0:r1, c0:c1] = True
     flag &= ~nan
-    rows, cols = np.nonzero(flag)
+    coarse = scene.imaging.edge_supersample
+    if 0 < coarse < supersample:  # edges away from every landmark get fewer rays
+        fine = flag & near_landmark
+        _resample(out, np.nonzero(flag & ~near_landmark), coarse, scene, shade, prims, rects)
+        flag = fine
+    _resample(out, np.nonzero(flag), supersample, scene, shade, prims, rects)
+    return out
+
+
+def _resample(out: np.ndarray, at: Tuple[np.ndarray, np.ndarray], n: int, scene: Scene,
+              shade: Shader, prims: List[Primitive], rects: List[Optional[Rect]]) -> None:
+    """Replace the pixels ``at`` by the mean of ``n²`` jittered N-rooks rays each."""
+    rows, cols = at
     if rows.size == 0:
-        return out
-    du, dv = _offsets(rows, cols, int(supersample))
-    at = (rows, cols)
+        return
+    grid, h = ray_grid(scene.camera), scene.camera_height_m
+    du, dv = _offsets(rows, cols, int(n))
     sx = grid.x[at][:, None] + grid.jxx[at][:, None] * du + grid.jxy[at][:, None] * dv
     sy = grid.y[at][:, None] + grid.jyx[at][:, None] * du + grid.jyy[at][:, None] * dv
     sub = trace_background(sx, -sy, scene, shade)
@@ -141,7 +157,6 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
             trace(sx[inside], -sy[inside], h, prim, shade, part)
             sub.put(inside, part)
     out[rows, cols] = sub.rad.mean(axis=1)
-    return out
 
 
 @functools.lru_cache(maxsize=4)

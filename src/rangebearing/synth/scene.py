@@ -196,7 +196,8 @@ class Imaging:
     grows with the gain it needs. ``bayer``: noise is drawn per photosite of an
     RGGB mosaic that is then demosaiced (colour fringes at band edges).
     ``glare``: the fraction of light scattered into a wide halo (veiling glare
-    from a bright window).
+    from a bright window). ``edge_supersample`` > 0: edges away from every
+    landmark get that many rays squared instead of the renderer's full count.
     """
 
     blur_sigma_px: float = 0.0
@@ -206,9 +207,10 @@ class Imaging:
     auto_exposure: bool = False
     ae_target: float = 0.18
     ae_error: float = 1.0
-    ae_limits: Tuple[float, float] = (0.3, 16.0)
+    ae_limits: Tuple[float, float] = (0.01, 16.0)
     bayer: bool = False
     glare: float = 0.0
+    edge_supersample: int = 0
 
 
 @frozen

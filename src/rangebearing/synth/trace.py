@@ -135,8 +135,8 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
         return
     with np.errstate(divide="ignore", invalid="ignore"):
         tc = (yc - h) / dy
-    xc = dx * tc
-    cap = (tc > 0.0) & ((xc - c.x) ** 2 + (tc - c.z) ** 2 <= c.r * c.r) & (tc < hits.t)
+        xc = dx * tc
+        cap = (tc > 0.0) & ((xc - c.x) ** 2 + (tc - c.z) ** 2 <= c.r * c.r) & (tc < hits.t)
     if cap.any():
         hits.t[cap], hits.ident[cap] = tc[cap], c.ident + part
         if shade.plain:

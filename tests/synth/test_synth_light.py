@@ -1,0 +1,84 @@
+"""Light and camera of the newer presets: spots, highlights, auto exposure, Bayer."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from rangebearing.synth import Imaging, LandmarkPose, Lighting, Poster, Scene, random_scene, render
+from rangebearing.synth.render import render_linear
+from rangebearing.synth.scene import Spot
+from rangebearing.synth.sensor import _mosaic, auto_exposure
+
+LM = LandmarkPose(0.5, 0.0)
+AE = Imaging(auto_exposure=True, ae_target=0.18)
+
+
+def _red_band_rows(scene: Scene) -> slice:
+    # the red band spans 0.120-0.135 m; the camera is at 0.10 m, f = 634 px, depth ~0.48 m
+    cy, f, z = scene.camera.cy_px, scene.camera.fy_px, LM.range_m - 0.0175
+    return slice(int(cy - f * 0.033 / z) + 2, int(cy - f * 0.022 / z) - 1)
+
+
+def test_plain_light_is_the_original_shading():
+    rich = Scene(landmarks=(LM,), lighting=Lighting(colour=(1.0, 1.0, 0.999999)))
+    plain = Scene(landmarks=(LM,))
+    assert not rich.lighting.plain and plain.lighting.plain
+    assert np.allclose(render_linear(rich), render_linear(plain), atol=1e-5)
+
+
+def test_a_spotlight_clips_the_band_and_washes_out_its_colour():
+    spot = Spot((0.1, 0.4, 0.3), (0.0, 0.1, 0.5), intensity=0.6, cone_deg=15.0)
+    light = Lighting(gloss=0.3, spots=(spot,))
+    lit = render(Scene(landmarks=(LM,), lighting=light))
+    plain = render(Scene(landmarks=(LM,), lighting=dataclasses.replace(light, spots=())))
+    rows, cols = _red_band_rows(Scene()), slice(300, 340)
+    band, ref = lit[rows, cols].astype(int), plain[rows, cols].astype(int)
+    assert ref[..., 2].max() < 255 and band[..., 2].max() == 255  # R clipped
+    assert band[..., 1].max() > ref[..., 1].max() + 60  # G rises: less saturated
+
+
+def test_auto_exposure_undoes_the_light_level():
+    scene = Scene(landmarks=(LM,), imaging=AE)
+    dim = dataclasses.replace(scene, lighting=Lighting(colour=(0.25,) * 3, ambient_colour=(0.25,) * 3))
+    lin, lin_dim = render_linear(scene), render_linear(dim)
+    assert auto_exposure(lin_dim, dim) == pytest.approx(4 * auto_exposure(lin, scene), rel=1e-3)
+    diff = np.abs(render(scene).astype(int) - render(dim).astype(int))
+    assert diff.mean() < 1.0
+
+
+def test_a_bright_window_behind_darkens_the_landmark():
+    scene = Scene(landmarks=(LM,), imaging=AE, wall_distance_m=1.0)
+    window = Poster(-0.15, 0.15, 0.0, 0.5, (1.0, 1.0, 1.0), emission=6.0)
+    backlit = dataclasses.replace(scene, posters=(window,))
+    assert auto_exposure(render_linear(backlit), backlit) < 0.6 * auto_exposure(render_linear(scene), scene)
+    body = (slice(225, 255), slice(312, 328))  # the white body
+    assert render(backlit)[body].mean() < 0.75 * render(scene)[body].mean()
+
+
+def test_bayer_mosaic_keeps_a_flat_colour():
+    flat = np.zeros((8, 8, 3), np.float32) + np.array([0.6, 0.2, 0.1], np.float32)
+    mos = _mosaic(flat)
+    assert mos[0, 0] == pytest.approx(0.6) and mos[0, 1] == pytest.approx(0.2)
+    assert mos[1, 1] == pytest.approx(0.1)
+    scene = Scene(imaging=Imaging(bayer=True), wall_distance_m=None,
+                  floor_colour=(0.5, 0.3, 0.2), lighting=Lighting(ambient=1.0, exposure=1.0))
+    img = render(scene).astype(int)
+    floor = img[300:, 10:-10]
+    ref = render(dataclasses.replace(scene, imaging=Imaging())).astype(int)[300:, 10:-10]
+    assert np.abs(floor - ref).max() <= 2
+
+
+def test_lighting_preset_covers_every_kind_of_light():
+    rng = np.random.default_rng(8)
+    scenes = [random_scene(rng, "lighting") for _ in range(60)]
+    assert any(s.lighting.spots for s in scenes)
+    assert any(any(p.emission > 0 for p in s.posters) or max(s.background_colour) > 1 for s in scenes)
+    assert any(max(s.lighting.colour) < 0.25 for s in scenes)  # dim
+    assert any(max(s.lighting.colour) > 1.4 for s in scenes)  # bright
+    tints = [max(s.lighting.colour) / min(s.lighting.colour) for s in scenes]
+    assert max(tints) > 1.6  # warm or coloured
+    assert all(s.imaging.auto_exposure and s.imaging.bayer for s in scenes)
+    assert any(s.imaging.ae_error > 1.3 for s in scenes)  # an over-shooting AE loop
