@@ -82,3 +82,22 @@ def test_lighting_preset_covers_every_kind_of_light():
     assert max(tints) > 1.6  # warm or coloured
     assert all(s.imaging.auto_exposure and s.imaging.bayer for s in scenes)
     assert any(s.imaging.ae_error > 1.3 for s in scenes)  # an over-shooting AE loop
+
+
+def test_floor_texture_varies_the_albedo_around_its_mean():
+    flat = Scene(wall_distance_m=None, lighting=Lighting(ambient=1.0, exposure=1.0))
+    textured = dataclasses.replace(flat, floor_texture=0.1, texture_seed=3)
+    a, b = render_linear(flat)[300:], render_linear(textured)[300:]
+    ratio = b[..., 1] / a[..., 1]
+    assert abs(ratio.mean() - 1.0) < 0.06 and 0.03 < ratio.std() < 0.15  # 0.3 m blotches: few in view
+    again = render_linear(dataclasses.replace(textured))[300:]
+    assert np.array_equal(b, again)  # the seed fixes the pattern
+    other = render_linear(dataclasses.replace(textured, texture_seed=4))[300:]
+    assert not np.array_equal(b, other)
+
+
+def test_vignetting_darkens_the_corners_by_its_amount():
+    grey = Scene(wall_distance_m=0.5, wall_colour=(0.4, 0.4, 0.4), camera_height_m=0.1,
+                 lighting=Lighting(ambient=1.0, exposure=1.0), imaging=Imaging(vignetting=0.3, gamma=1.0))
+    img = render(grey).astype(float)
+    assert img[0, 0, 1] / img[240, 320, 1] == pytest.approx(0.7, abs=0.02)

@@ -9,7 +9,8 @@ robot, glossy highlights that clip); ``backlit`` (a bright window behind the
 robots, the auto exposure darkening everything else, veiling glare).
 
 Every one runs the camera of :mod:`.sensor`: auto exposure, Bayer mosaic,
-noise growing with gain.
+noise growing with gain, vignetting. Rooms have textured floors and walls, and
+now and then a strongly coloured floor (a navy carpet) or wall.
 """
 
 from __future__ import annotations
@@ -98,16 +99,41 @@ def imaging(rng: np.random.Generator, kind: str) -> Imaging:
     return Imaging(blur_sigma_px=d.uniform(rng, 0.3, 0.9), read_noise=d.uniform(rng, 0.002, 0.005),
                    shot_noise=d.uniform(rng, 0.0003, 0.001), auto_exposure=True,
                    ae_target=d.uniform(rng, 0.14, 0.2), ae_error=err, bayer=True, glare=glare,
-                   edge_supersample=2)
+                   edge_supersample=2, vignetting=d.uniform(rng, 0.1, 0.35))
+
+
+FLOORS = {
+    "navy carpet": (0.045, 0.06, 0.19),  # the carpet that pulled grey-world balance to blue
+    "red carpet": (0.30, 0.05, 0.05),
+    "dark wood": (0.22, 0.12, 0.06),
+    "black rubber": (0.05, 0.05, 0.05),
+}
+WALLS = {
+    "red brick": (0.42, 0.14, 0.09),
+    "blue paint": (0.16, 0.24, 0.50),
+    "white": (0.86, 0.86, 0.84),
+}
+
+
+def room(rng: np.random.Generator) -> dict:
+    """Floor and wall colours and textures: tinted, neutral, and now and then strongly coloured."""
+    out = d.tinted_room(rng) if rng.random() < 0.6 else d.neutral_room(rng)
+    if rng.random() < 0.2:
+        out["floor_colour"] = d.jitter(rng, d.pick(rng, FLOORS), 0.015)
+    if rng.random() < 0.12:
+        out["wall_colour"] = d.jitter(rng, d.pick(rng, WALLS), 0.02)
+    out.update(floor_texture=d.uniform(rng, 0.03, 0.15), wall_texture=d.uniform(rng, 0.0, 0.05),
+               texture_seed=int(rng.integers(2**31)))
+    return out
 
 
 def base_scene(rng: np.random.Generator, camera: CameraIntrinsics, kind: str,
                camera_height: Tuple[float, float] = (0.10, 0.10)) -> Scene:
-    """A room (tinted or neutral), light of ``kind`` and the camera; no robots yet."""
-    room = d.tinted_room(rng) if rng.random() < 0.6 else d.neutral_room(rng)
+    """A room (see :func:`room`), light of ``kind`` and the camera; no robots yet."""
+    walls_floor = room(rng)
     h = camera_height[0] if camera_height[0] == camera_height[1] else d.uniform(rng, *camera_height)
     return Scene(camera=camera, camera_height_m=h, lighting=lighting(rng, kind),
-                 imaging=imaging(rng, kind), **room)
+                 imaging=imaging(rng, kind), **walls_floor)
 
 
 def _spot(rng: np.random.Generator, scene: Scene) -> Spot:

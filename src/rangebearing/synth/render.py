@@ -170,10 +170,10 @@ def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator]
 
     Blur (optical, linear light) → exposure × white-balance gains → shot and
     read noise (only with an ``rng``) → clip to [0, 1] → gamma → 8 bits.
-    With auto exposure, a Bayer mosaic or glare, :func:`.sensor.develop_sensor`.
+    With auto exposure, a Bayer mosaic, glare or vignetting, :func:`.sensor.develop_sensor`.
     """
     im, li = scene.imaging, scene.lighting
-    if im.auto_exposure or im.bayer or im.glare > 0:
+    if im.auto_exposure or im.bayer or im.glare > 0 or im.vignetting > 0:
         return develop_sensor(linear, scene, rng, _gamma_lut(float(im.gamma)))
     img = linear.astype(np.float32)
     if im.blur_sigma_px > 0.05:

@@ -198,6 +198,7 @@ class Imaging:
     ``glare``: the fraction of light scattered into a wide halo (veiling glare
     from a bright window). ``edge_supersample`` > 0: edges away from every
     landmark get that many rays squared instead of the renderer's full count.
+    ``vignetting``: the fraction of light lost in the image corners (cos⁴-like).
     """
 
     blur_sigma_px: float = 0.0
@@ -211,11 +212,16 @@ class Imaging:
     bayer: bool = False
     glare: float = 0.0
     edge_supersample: int = 0
+    vignetting: float = 0.0
 
 
 @frozen
 class Scene:
     """Everything one frame shows. ``wall_distance_m=None`` is an open room.
+
+    ``floor_texture`` and ``wall_texture`` > 0 vary the floor's (and mats') and
+    the wall's albedo by about that fraction (a smooth pattern from 0.4 m down
+    to 4 mm, as carpet, concrete or painted plaster; ``texture_seed`` picks it).
 
     Examples
     --------
@@ -235,6 +241,9 @@ class Scene:
     wall_colour: RGB = (0.78, 0.78, 0.78)
     posters: Tuple[Poster, ...] = ()
     background_colour: RGB = (0.30, 0.30, 0.30)
+    floor_texture: float = 0.0
+    wall_texture: float = 0.0
+    texture_seed: int = 0
     lighting: Lighting = Lighting()
     imaging: Imaging = Imaging()
 

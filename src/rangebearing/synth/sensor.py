@@ -1,6 +1,6 @@
 """The camera behind the lens for the newer presets: auto exposure, Bayer mosaic, glare.
 
-Order, as in a camera: veiling glare and optical blur (linear light) → the AE
+Order, as in a camera: veiling glare, optical blur and vignetting → the AE
 loop picks the exposure from the scene (what it meters is already clipped,
 as a real sensor's statistics are) → the raw exposure, clipped at full scale
 per colour site (so a highlight clips before white balance) → shot and read
@@ -11,6 +11,7 @@ RGGB mosaic at 10 bits and edge-aware demosaic → white-balance gains → gamma
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Optional
 
@@ -28,6 +29,17 @@ def _metering_weights(h: int, w: int) -> np.ndarray:
     yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
     g = np.exp(-(((xx - (w - 1) / 2) / (0.45 * w)) ** 2 + ((yy - (h - 1) / 2) / (0.45 * h)) ** 2))
     return g / g.sum()
+
+
+@functools.lru_cache(maxsize=8)
+def _vignette(h: int, w: int, amount: float) -> np.ndarray:
+    """Relative illumination: 1 at the centre, ``1 − amount`` in the corners (cos⁴-like)."""
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    r2 = ((xx - (w - 1) / 2) ** 2 + (yy - (h - 1) / 2) ** 2) / (((w - 1) / 2) ** 2 + ((h - 1) / 2) ** 2)
+    falloff = 1.0 / (1.0 + r2 * (1.0 / np.sqrt(1.0 - amount) - 1.0)) ** 2
+    falloff = falloff.astype(np.float32)
+    falloff.setflags(write=False)
+    return falloff
 
 
 def auto_exposure(linear: np.ndarray, scene: Scene) -> float:
@@ -71,6 +83,8 @@ def develop_sensor(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Gen
         img = (1.0 - im.glare) * img + np.float32(im.glare) * halo
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
+    if im.vignetting > 0:
+        img *= _vignette(*img.shape[:2], float(im.vignetting))[..., None]
     exposure = auto_exposure(img, scene) if im.auto_exposure else li.exposure
     gain = max(exposure / NOMINAL_EXPOSURE, 1.0)
     raw = np.minimum(img * np.float32(exposure), 1.0)  # photosites saturate

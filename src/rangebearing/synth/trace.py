@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import texture
 from .lights import Shader
 from .parts import build, primitives
 from .scene import Scene
@@ -100,7 +101,23 @@ def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader
             pts = _points(dx, dy, h, t).reshape(-1, 3)[flat]
             shaded = shade.rich(rad.reshape(-1, 3)[flat], normals, pts)
             rad.reshape(-1, 3)[flat] = shaded
+    if scene.floor_texture > 0 or scene.wall_texture > 0:
+        _texture(rad, ident, dx, dy, t, scene)
     return Hits(t, ident, rad)
+
+
+def _texture(rad: np.ndarray, ident: np.ndarray, dx: np.ndarray, dy: np.ndarray, t: np.ndarray,
+             scene: Scene) -> None:
+    """Multiply floor, mat and wall radiance by their albedo pattern, in place."""
+    floor = (ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER))
+    if scene.floor_texture > 0 and floor.any():
+        tf = t[floor]
+        rad[floor] *= texture.factor(dx[floor] * tf, tf, scene.texture_seed, scene.floor_texture)[:, None]
+    wall = ident == ID_WALL
+    if scene.wall_texture > 0 and wall.any():
+        tw = t[wall]
+        rad[wall] *= texture.factor(dx[wall] * tw, scene.camera_height_m + dy[wall] * tw,
+                                    scene.texture_seed + 1, scene.wall_texture)[:, None]
 
 
 def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shader,
