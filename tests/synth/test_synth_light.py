@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rangebearing.synth import Imaging, LandmarkPose, Lighting, Poster, Scene, random_scene, render
+from rangebearing.synth import Box, Imaging, LandmarkPose, Lighting, Poster, Scene, random_scene, render
 from rangebearing.synth.render import render_linear
 from rangebearing.synth.scene import Spot
 from rangebearing.synth.sensor import _mosaic, auto_exposure
@@ -101,3 +101,16 @@ def test_vignetting_darkens_the_corners_by_its_amount():
                  lighting=Lighting(ambient=1.0, exposure=1.0), imaging=Imaging(vignetting=0.3, gamma=1.0))
     img = render(grey).astype(float)
     assert img[0, 0, 1] / img[240, 320, 1] == pytest.approx(0.7, abs=0.02)
+
+
+def test_a_board_between_the_light_and_the_landmark_shadows_it():
+    # light from above and behind the camera; a board 0.17-0.19 m up at z = 0.40 m is
+    # above the camera's view of the landmark but on the way from it to the light
+    light = Lighting(direction=(0.0, 1.0, -1.0), gloss=0.05)
+    lm = LandmarkPose(0.5, 0.0)
+    board = Box(0.0, 0.40, 0.2, 0.01, 0.17, 0.19, (0.5, 0.5, 0.5))
+    body = (slice(230, 250), slice(310, 330))
+    open_sky = render_linear(Scene(landmarks=(lm,), lighting=light))[body].mean()
+    shaded = render_linear(Scene(landmarks=(lm,), lighting=light, boxes=(board,)))[body].mean()
+    assert shaded == pytest.approx(light.ambient * 0.85, rel=0.01)  # ambient only: in full shadow
+    assert open_sky > 1.8 * shaded

@@ -3,18 +3,20 @@
 :class:`Shader` keeps the original scalar form, ``albedo · (ambient + (1 −
 ambient)·max(0, n·l))``, for plain light (white, no spots, no gloss), so the
 original presets render bit for bit as before; :meth:`Shader.rich` handles
-coloured light, point lights with a cone and Blinn-Phong highlights, and needs
-each hit's normal and position.
+coloured light, point lights with a cone, Blinn-Phong highlights and shadows
+cast onto landmarks (:mod:`.shadows`), and needs each hit's normal and position.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Tuple
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
+from . import shadows
 from .scene import Scene
+from .shapes import Primitive
 
 
 @dataclass(frozen=True)
@@ -33,9 +35,13 @@ class Shader:
     gloss: float = 0.0
     shininess: float = 60.0
     eye: Tuple[float, float, float] = (0.0, 0.1, 0.0)
+    casters: shadows.Casters = field(default_factory=shadows.empty_casters)
 
     @classmethod
-    def from_scene(cls, scene: Scene) -> Shader:
+    def from_scene(cls, scene: Scene, prims: Optional[Sequence[Primitive]] = None,
+                   landmarks: Sequence[int] = ()) -> Shader:
+        """The scene's light; with its primitives (and which are landmarks), under rich
+        light the landmarks also receive shadows from the others."""
         li = scene.lighting
         d = np.asarray(li.direction, dtype=np.float64)
         light = d / np.linalg.norm(d)
@@ -47,9 +53,10 @@ class Shader:
         power = np.array([np.multiply(s.colour, s.intensity) for s in li.spots]).reshape(-1, 3)
         cone = np.array([(np.cos(np.radians(s.cone_deg)), np.cos(np.radians(s.cone_deg + s.soft_deg)))
                          for s in li.spots]).reshape(-1, 2)
+        cast = shadows.casters(prims, landmarks, light, pos) if prims is not None else {}
         return cls(light, float(li.ambient), False, np.asarray(li.colour, float),
                    np.asarray(li.ambient_colour, float), pos, axis, power, cone,
-                   float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0))
+                   float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0), cast)
 
     def __call__(self, albedo: np.ndarray, cos: np.ndarray) -> np.ndarray:
         """Plain Lambert: ``cos`` is n·l per hit; returns (..., 3) radiance."""
@@ -57,12 +64,16 @@ class Shader:
         return np.asarray(albedo) * k[..., None]
 
     def rich(self, albedo: np.ndarray, normal: np.ndarray, point: np.ndarray,
-             glossy: bool = False) -> np.ndarray:
-        """Radiance (K, 3) of hits with unit ``normal`` and ``point`` (K, 3), world frame."""
+             glossy: bool = False, owner: Optional[int] = None) -> np.ndarray:
+        """Radiance (K, 3) of hits with unit ``normal`` and ``point`` (K, 3), world frame;
+        ``owner`` (a landmark's id) makes the hits receive shadows."""
         albedo = np.broadcast_to(np.asarray(albedo, dtype=np.float64), point.shape)
         normal = np.broadcast_to(normal, point.shape)
         cos = normal @ self.light
+        sun, per_spot = self.casters.get(owner, ((), ())) if owner is not None else ((), ())
         direct = (1.0 - self.ambient) * np.maximum(cos, 0.0)
+        if sun:
+            direct = direct * shadows.lit(point, self.light, None, sun)
         irr = self.ambient * self.ambient_colour + direct[:, None] * self.colour
         spec = np.zeros(point.shape) if glossy and self.gloss > 0 else None
         view = None
@@ -73,8 +84,8 @@ class Shader:
             half /= np.maximum(np.linalg.norm(half, axis=1, keepdims=True), 1e-12)
             nh = np.clip(np.einsum("ij,ij->i", normal, half), 0.0, None)
             spec += (direct > 0)[:, None] * (1.0 - self.ambient) * nh[:, None] ** self.shininess * self.colour
-        for pos, axis, power, (inner, outer) in zip(self.spot_pos, self.spot_axis, self.spot_power,
-                                                   self.spot_cone):
+        for i, (pos, axis, power, (inner, outer)) in enumerate(
+                zip(self.spot_pos, self.spot_axis, self.spot_power, self.spot_cone)):
             to = pos - point
             d2 = np.maximum(np.einsum("ij,ij->i", to, to), 1e-6)
             ldir = to / np.sqrt(d2)[:, None]
@@ -82,6 +93,8 @@ class Shader:
             fall = np.clip((off - outer) / max(inner - outer, 1e-9), 0.0, 1.0)
             fall = fall * fall * (3.0 - 2.0 * fall)
             lam = np.maximum(np.einsum("ij,ij->i", normal, ldir), 0.0)
+            if per_spot and per_spot[i]:
+                lam = lam * shadows.lit(point, ldir, np.sqrt(d2), per_spot[i])
             e = fall / d2
             irr += (lam * e)[:, None] * power
             if spec is not None and view is not None:

@@ -27,7 +27,7 @@ import numpy as np
 from .camera import Rect, pixel_rect, ray_grid
 from .scene import Scene
 from .sensor import develop_sensor
-from .trace import Cyl, Primitive, Shader, primitives, trace, trace_background
+from .trace import Cyl, Primitive, Shader, build, trace, trace_background
 
 SMALL_LANDMARK_PX = 2500  # image extents up to this many pixels are supersampled whole
 
@@ -101,8 +101,8 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
     cam, h = scene.camera, scene.camera_height_m
     grid = ray_grid(cam)
     dx, dy = grid.x, -grid.y
-    shade = Shader.from_scene(scene)
-    prims = primitives(scene)
+    prims, landmarks = build(scene)
+    shade = Shader.from_scene(scene, prims, landmarks)
     if not shade.plain:  # nearest first: hidden surfaces fail the depth test before shading
         prims.sort(key=lambda p: p.extent()[4])
     hits = trace_background(dx, dy, scene, shade)

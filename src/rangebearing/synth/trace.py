@@ -109,15 +109,20 @@ def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader
 def _texture(rad: np.ndarray, ident: np.ndarray, dx: np.ndarray, dy: np.ndarray, t: np.ndarray,
              scene: Scene) -> None:
     """Multiply floor, mat and wall radiance by their albedo pattern, in place."""
-    floor = (ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER))
-    if scene.floor_texture > 0 and floor.any():
-        tf = t[floor]
-        rad[floor] *= texture.factor(dx[floor] * tf, tf, scene.texture_seed, scene.floor_texture)[:, None]
-    wall = ident == ID_WALL
-    if scene.wall_texture > 0 and wall.any():
-        tw = t[wall]
-        rad[wall] *= texture.factor(dx[wall] * tw, scene.camera_height_m + dy[wall] * tw,
-                                    scene.texture_seed + 1, scene.wall_texture)[:, None]
+    gain = np.ones(ident.shape)
+    with np.errstate(invalid="ignore"):
+        if scene.floor_texture > 0:
+            floor = (ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER))
+            tf = np.where(floor, t, 0.0)
+            f = texture.factor(dx * tf, tf, scene.texture_seed, scene.floor_texture)
+            gain = np.where(floor, f, gain)
+        if scene.wall_texture > 0:
+            wall = ident == ID_WALL
+            tw = np.where(wall, t, 0.0)
+            f = texture.factor(dx * tw, scene.camera_height_m + dy * tw, scene.texture_seed + 1,
+                               scene.wall_texture)
+            gain = np.where(wall, f, gain)
+    rad *= gain[..., None]
 
 
 def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shader,
@@ -143,7 +148,8 @@ def trace_cylinder(dx: np.ndarray, dy: np.ndarray, h: float, c: Cyl, shade: Shad
         else:
             n = np.stack([nx, np.zeros_like(nx), nz], axis=-1)
             pts = np.stack([dx[side] * ts, ys, ts], axis=-1)
-            hits.rad[side] = shade.rich(c.colours[seg], n, pts, c.glossy)
+            hits.rad[side] = shade.rich(c.colours[seg], n, pts, c.glossy,
+                                        c.ident if c.glossy else None)
     if h > c.y1:
         yc, sign, part = c.y1, 1.0, PARTS - 1
     elif h < c.y0:
