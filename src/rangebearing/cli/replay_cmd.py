@@ -14,6 +14,7 @@ from ..core.pipeline import Pipeline
 from ..core.types import Landmark
 from ..errors import FrameError, OutputError, SourceError
 from ..evaluation.annotate import annotate
+from ..evaluation.identity import format_id_report, id_report
 from ..evaluation.match import accuracy, format_report
 from ..evaluation.truth import read_truth
 from ..net.protocol import landmark_fields
@@ -26,7 +27,8 @@ def register(sub: Any) -> None:
         "replay",
         help="run the pipeline over recorded frames",
         description="Run the pipeline over a directory of images (sorted by name) or a video file. "
-        "Prints one line of readings per frame; --truth adds an accuracy report.",
+        "Prints one line of readings per frame; --truth adds an accuracy report, and with --track and a truth "
+        "that names each landmark's robot (synth's robot column), a track-id report (id switches, returns).",
     )
     p.add_argument("path", help="directory of .png/.jpg/.jpeg/.bmp images, or a video file")
     add_config_arg(p)
@@ -102,4 +104,6 @@ def run(args: argparse.Namespace) -> int:
             raise SourceError(f"no frames of {path} could be evaluated")
         report, _ = accuracy(evaluated)
         print(format_report(report) + (f"\n(the first {len(evaluated)} frames only)" if interrupted else ""))
+        if pipe.ids and any(t.robot is not None for _, _, rows in evaluated for t in rows):
+            print(format_id_report(id_report((found, rows) for _, found, rows in evaluated)))
     return 130 if interrupted else 0

@@ -90,7 +90,8 @@ def assign_gated(cost: np.ndarray, gate: float) -> Tuple[np.ndarray, np.ndarray]
     ----------
     cost : numpy.ndarray
         ``(n_tracks, n_detections)`` float array (e.g. squared Mahalanobis
-        distances); NaN counts as outside the gate.
+        distances, or a negative log-likelihood); NaN and infinity count as
+        outside the gate.
     gate : float
         Pairs costing more are never made.
 
@@ -109,7 +110,7 @@ def assign_gated(cost: np.ndarray, gate: float) -> Tuple[np.ndarray, np.ndarray]
     maximises the number of gated pairs and then minimises their total cost.
     """
     n, m = cost.shape
-    inside = cost <= gate  # False for NaN
+    inside = np.isfinite(cost) & (cost <= gate)  # NaN and infinity are outside
     if n == 0 or m == 0 or not inside.any():
         return np.empty(0, dtype=np.intp), np.empty(0, dtype=np.intp)
     per_row = inside.sum(axis=1)

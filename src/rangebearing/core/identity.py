@@ -15,8 +15,8 @@ Each frame (:func:`update`):
    prediction, with the innovation covariance (prediction plus the reading's
    noise); pairs beyond ``gate_d2`` are never made;
 3. assign globally (:func:`~rangebearing.core.assignment.assign_gated`: the
-   most gated pairs, then the least total ``d²``; a Hungarian solver for
-   overlapping gates), update the matched tracks;
+   most gated pairs, then the least total ``d² + ln det S``; a Hungarian
+   solver for overlapping gates), update the matched tracks;
 4. unmatched tracks coast; one unmatched for more than ``max_hidden_frames``
    frames in a row is dropped; each unmatched detection starts a track with
    the next id.
@@ -28,12 +28,14 @@ returns a new one and never reads a clock.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from .assignment import assign_gated
+from .types import Landmark
 
 RANGE, BEARING = 0, 1  # channels of the state and covariance arrays
 
@@ -59,8 +61,13 @@ class IdentityParams:
     yaw_accel_radps2: float = 1.0  # half of a 2 rad/s² bound
     range_rate_prior_mps: float = 0.6
     bearing_rate_prior_radps: float = 2.0
-    min_range_sigma_frac: float = 0.004  # of the range
-    min_bearing_sigma_rad: float = 0.001
+    min_range_sigma_frac: float = 0.01  # of the range
+    min_bearing_sigma_rad: float = 0.0015
+    # a reading of a merged or partly hidden landmark can be off by far more than its sigma says:
+    # such outliers (this fraction of readings) are modelled with these wider sigmas
+    outlier_fraction: float = 0.05
+    outlier_range_frac: float = 0.05  # of the range
+    outlier_bearing_rad: float = 0.015
     nominal_dt_s: float = 1.0 / 30.0  # frame interval when the frames carry no time
     max_dt_s: float = 1.0  # a longer gap is predicted as this long (a paused source)
     rate_after_updates: int = 3  # rates are published from this many measurements on
@@ -144,11 +151,18 @@ def predict(x: np.ndarray, p: np.ndarray, dt_s: float, params: IdentityParams) -
 # two bearings of one neighbour is far from ±π.
 
 
-def distances(x: np.ndarray, p: np.ndarray, z: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """``(n, m)`` squared Mahalanobis distances of ``m`` readings ``z`` (``(m, 2)``, variances ``r``)
-    from ``n`` predicted tracks."""
-    innov = z[None, :, :] - x[:, None, :, 0]
-    return (np.square(innov) / (p[:, None, :, 0] + r[None, :, :])).sum(axis=2)
+def distances(x: np.ndarray, p: np.ndarray, z: np.ndarray, r: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    """Squared Mahalanobis distances ``d²`` of ``m`` readings ``z`` (``(m, 2)``, variances ``r``)
+    from ``n`` predicted tracks, and ``d² + ln det S`` (twice the negative log-likelihood
+    but for a constant), both ``(n, m)``.
+
+    The log-determinant makes a confident track win over a vague one (a newcomer,
+    or one coasting unseen) at the same ``d²``: a vague track's gate is wide, so
+    ``d²`` alone would hand it readings that belong to a neighbour it overlaps.
+    """
+    s = p[:, None, :, 0] + r[None, :, :]
+    d2 = (np.square(z[None, :, :] - x[:, None, :, 0]) / s).sum(axis=2)
+    return d2, d2 + np.log(s[:, :, RANGE] * s[:, :, BEARING])
 
 
 def correct(x: np.ndarray, p: np.ndarray, z: np.ndarray, r: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
@@ -229,11 +243,20 @@ def update(
     r = measurement_variance(z[:, RANGE], np.asarray(range_sigma_m, float), np.asarray(bearing_sigma_rad, float),
                              params)
     x, p = predict(state.x, state.p, _dt(state, t_s, params), params)
-    rows, cols = assign_gated(distances(x, p, z, r), params.gate_d2)
+    rw = np.maximum(r, np.square(np.stack([params.outlier_range_frac * z[:, RANGE],
+                                           np.full(m, params.outlier_bearing_rad)], axis=1)))
+    d2, nll = distances(x, p, z, r)
+    d2w, nllw = distances(x, p, z, rw)
+    good = np.log1p(-params.outlier_fraction) - 0.5 * nll  # log-likelihoods of the two kinds of reading
+    bad = np.log(params.outlier_fraction) - 0.5 * nllw
+    established = state.updates >= params.rate_after_updates  # only a track with a motion takes outliers
+    gated = (d2 <= params.gate_d2) | ((d2w <= params.gate_d2) & established[:, None])
+    rows, cols = assign_gated(np.where(gated, -2.0 * np.logaddexp(good, bad), np.inf), np.inf)
     hidden = state.hidden + 1
     updates = state.updates.copy()
     if rows.size:
-        x[rows], p[rows] = correct(x[rows], p[rows], z[cols], r[cols])
+        outlier = (bad > good)[rows, cols]
+        x[rows], p[rows] = correct(x[rows], p[rows], z[cols], np.where(outlier[:, None], rw[cols], r[cols]))
         hidden[rows] = 0
         updates[rows] += 1
     ids, next_id = state.ids, state.next_id
@@ -257,3 +280,30 @@ def update(
     if not keep.all():
         ids, x, p, hidden, updates = ids[keep], x[keep], p[keep], hidden[keep], updates[keep]
     return IdentityState(ids, x, p, hidden, updates, next_id, t_s), identified
+
+
+def identify(
+    state: IdentityState, landmarks: Sequence[Landmark], t_s: Optional[float], params: IdentityParams = DEFAULT_PARAMS
+) -> Tuple[IdentityState, Tuple[Landmark, ...]]:
+    """:func:`update` for a frame's landmarks: the same landmarks, in the same order, with
+    ``track_id``, ``range_rate_mps`` and ``bearing_rate_radps`` filled in.
+
+    The measured fields (``range_m``, ``bearing_rad``, the sigmas, …) are
+    copied unchanged: the filter only adds rates.
+    """
+    state, out = update(
+        state,
+        [lm.range_m for lm in landmarks],
+        [lm.bearing_rad for lm in landmarks],
+        [lm.range_sigma_m for lm in landmarks],
+        [lm.bearing_sigma_rad for lm in landmarks],
+        t_s,
+        params,
+    )
+    labelled = tuple(
+        replace(lm, track_id=int(tid), range_rate_mps=None if rr != rr else float(rr),
+                bearing_rate_radps=None if br != br else float(br))  # NaN (no history yet) -> None
+        for lm, tid, rr, br in zip(landmarks, out.track_id.tolist(), out.range_rate_mps.tolist(),
+                                   out.bearing_rate_radps.tolist())
+    )
+    return state, labelled

@@ -5,6 +5,11 @@ previous frame's landmarks and measures them again in small windows where they
 should be (:mod:`rangebearing.core.tracking`), with a full-frame search every
 ``full_scan_every`` frames, after a landmark is lost, and whenever nothing is
 tracked, so a newcomer is found within ``full_scan_every`` frames.
+
+Every landmark of a sequence also gets a stable ``track_id`` and, once its
+track has history, range and bearing rates (:mod:`rangebearing.core.identity`,
+run after measurement on the landmarks themselves, whether they were found by
+a full scan or in tracking windows).
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ import numpy as np
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, find_candidates, refine
+from .identity import IdentityState, empty_state, identify
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .params import PipelineParams
@@ -39,22 +45,44 @@ class Pipeline:
         Search only around last frame's landmarks between full-frame scans.
         ``None`` takes ``params.detection.tracking``. Use ``False`` for frames
         that are not a sequence.
+    ids : bool, optional
+        Give every landmark a track id and rates. ``None``: unless ``track``
+        is ``False`` (independent frames), so a sequence gets ids even with
+        window tracking switched off in the config.
+    first_track_id : int
+        The id of the first track (a daemon that rebuilds its pipeline on a
+        config reload passes the old pipeline's :attr:`next_track_id`, so no
+        id is reused within its run).
     """
 
-    def __init__(self, params: PipelineParams, track: Optional[bool] = None) -> None:
+    def __init__(self, params: PipelineParams, track: Optional[bool] = None, ids: Optional[bool] = None,
+                 first_track_id: int = 0) -> None:
         if not isinstance(params, PipelineParams):
             raise TypeError(f"Pipeline takes PipelineParams (a config's .pipeline), not {type(params).__name__}")
         self.params = params
         self.track = params.detection.tracking if track is None else track
+        self.ids = (track is not False) if ids is None else ids
         self.limits = PairingLimits()
         self._cams: Dict[Tuple[int, int], Tuple[CameraIntrinsics, int]] = {}
+        self._identity: IdentityState = empty_state(first_track_id)
         self.reset()
 
-    def reset(self) -> None:
-        """Forget tracked landmarks; the next frame gets a full-frame search."""
+    @property
+    def next_track_id(self) -> int:
+        """The id the next new track will get."""
+        return self._identity.next_id
+
+    def reset(self, new_run: bool = False) -> None:
+        """Forget tracked landmarks; the next frame gets a full-frame search.
+
+        Track ids keep counting, so none is reused for the pipeline's lifetime;
+        ``new_run=True`` starts them again at 0, for frames that have nothing
+        to do with the earlier ones (another recording).
+        """
         self._tracks: List[Track] = []
         self._since_scan = 0
         self._gains: Gains = UNIT_GAINS
+        self._identity = empty_state(0 if new_run else self._identity.next_id)
 
     def _camera(self, w: int, h: int) -> Tuple[CameraIntrinsics, int]:
         """Intrinsics for this frame size and the band-preserving filter size."""
@@ -66,8 +94,12 @@ class Pipeline:
             self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))
         return self._cams[key]
 
-    def process(self, frame: np.ndarray) -> FrameResult:
+    def process(self, frame: np.ndarray, t_s: Optional[float] = None) -> FrameResult:
         """Find every landmark in a BGR uint8 frame; nearest first.
+
+        ``t_s`` is the frame's capture time in seconds on any steady clock
+        (the daemon passes the camera's timestamp); it sets the time step of
+        the rate filters. Without it frames are taken to be 1/30 s apart.
 
         Raises
         ------
@@ -103,6 +135,9 @@ class Pipeline:
         landmarks = sorted(
             (lm for lm in map(self._landmark, found, [cam] * len(found)) if lm.range_m > 0), key=lambda lm: lm.range_m
         )
+        if self.ids:
+            self._identity, labelled = identify(self._identity, landmarks, t_s)
+            return FrameResult(landmarks=labelled, tracked=tracked)
         return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
 
     def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:

@@ -138,7 +138,7 @@ class Daemon:
                     log.info("end of stream")
                     return 0
                 t0 = clock()
-                result = self._pipe.process(frame.image)
+                result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9)
                 t1 = clock()
                 pub = self.cfg.publish
                 payload = encode_reading(pub.robot_id, seq, _unix_time(frame, t1), result.landmarks, self.stats.fps,
@@ -165,7 +165,7 @@ class Daemon:
         if new is None:
             return
         self.cfg = dataclasses.replace(self.cfg, detection=new.apply(self.cfg.detection))
-        self._pipe = Pipeline(self.cfg.pipeline)
+        self._pipe = Pipeline(self.cfg.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
         log.info("thresholds set from the view page: %s (not saved)", new.as_json())
 
     def _echo(self, payload: bytes) -> None:
@@ -205,7 +205,7 @@ class Daemon:
                 return
             self._publisher.close()  # type: ignore[union-attr]
             if new.pipeline != self.cfg.pipeline:
-                self._pipe = Pipeline(new.pipeline)
+                self._pipe = Pipeline(new.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
             if new.daemon.view_port != self.cfg.daemon.view_port or new.daemon.view_host != self.cfg.daemon.view_host:
                 log.warning("daemon.view_port / view_host changes take effect at the next start")
             self._publisher, self.cfg = new_pub, new
