@@ -68,6 +68,8 @@ class IdentityParams:
     outlier_fraction: float = 0.05
     outlier_range_frac: float = 0.05  # of the range
     outlier_bearing_rad: float = 0.015
+    # a young track (fewer than rate_after_updates readings) yields to an established one it competes with
+    young_penalty: float = 10.0  # added to -2 ln(likelihood)
     nominal_dt_s: float = 1.0 / 30.0  # frame interval when the frames carry no time
     max_dt_s: float = 1.0  # a longer gap is predicted as this long (a paused source)
     rate_after_updates: int = 3  # rates are published from this many measurements on
@@ -251,7 +253,8 @@ def update(
     bad = np.log(params.outlier_fraction) - 0.5 * nllw
     established = state.updates >= params.rate_after_updates  # only a track with a motion takes outliers
     gated = (d2 <= params.gate_d2) | ((d2w <= params.gate_d2) & established[:, None])
-    rows, cols = assign_gated(np.where(gated, -2.0 * np.logaddexp(good, bad), np.inf), np.inf)
+    cost = -2.0 * np.logaddexp(good, bad) + np.where(established, 0.0, params.young_penalty)[:, None]
+    rows, cols = assign_gated(np.where(gated, cost, np.inf), np.inf)
     hidden = state.hidden + 1
     updates = state.updates.copy()
     if rows.size:

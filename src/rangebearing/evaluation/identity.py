@@ -28,15 +28,15 @@ from ..core.assignment import assign_gated
 from ..core.types import Landmark
 from .truth import TruthRow
 
-GAP_RAD = math.radians(3.0)  # as evaluation.match: farther is not this landmark
-GAP_RANGE_FRAC = 0.15
+GAP_RAD = math.radians(2.0)  # farther is not a reading of this robot
+GAP_RANGE_FRAC = 0.10
 
 
 def match_identities(found: Sequence[Landmark], truths: Sequence[TruthRow]) -> List[Tuple[TruthRow, Landmark]]:
     """Pairs (truth, detection) for the findable truths that have a ``robot`` id.
 
     Cost: squared bearing error in degrees plus squared range error in units
-    of 5 % of the range; pairs more than 3° or 15 % apart are never made.
+    of 5 % of the range; pairs more than 2° or 10 % apart are never made.
     A hidden robot straight behind a visible one is not findable, so it never
     takes the visible one's detection.
     """
