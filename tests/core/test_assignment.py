@@ -74,3 +74,19 @@ def test_assign_gated_matches_brute_force_on_random_gates():
                         best = (k, float(cost.sum()))
         assert rows.size == best[0]
         assert c[rows, cols].sum() == pytest.approx(best[1])
+
+
+def test_an_infinite_gate_with_overlapping_candidates_stays_finite():
+    # every finite cost counts; the solver must not see inf - inf (it once did)
+    c = np.array([[1.0, 2.0], [1.5, np.inf]])
+    rows, cols = assign_gated(c, gate=np.inf)
+    assert sorted(zip(rows.tolist(), cols.tolist())) == [(0, 1), (1, 0)]
+
+
+def test_with_a_price_for_leaving_things_unmatched_one_good_pair_beats_two_poor_ones():
+    c = np.array([[1.0, 11.0], [7.0, np.inf]])
+    assert sorted(zip(*(a.tolist() for a in assign_gated(c, 16.0)))) == [(0, 1), (1, 0)]  # most pairs
+    rows, cols = assign_gated(c, 16.0, unmatched=4.0)  # 11 + 7 > 1 + 4 + 4
+    assert sorted(zip(rows.tolist(), cols.tolist())) == [(0, 0)]
+    rows, cols = assign_gated(np.array([[9.0]]), 16.0, unmatched=4.0)  # dearer than two leftovers
+    assert rows.size == 0

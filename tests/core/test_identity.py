@@ -160,3 +160,23 @@ def test_a_far_jump_starts_a_new_track_and_a_zero_sigma_is_floored():
     assert out.track_id.tolist() == [0]
     state, out = update(state, [0.5], [0.5], [0.0], [0.0], None, P)  # 29° away in one frame
     assert out.track_id.tolist() == [1]
+
+
+def test_a_landmark_read_twice_is_one_neighbour():
+    state = empty_state()
+    for _ in range(5):
+        state, out = _frame(state, [(0.6, 0.1)])
+    state, out = _frame(state, [(0.6, 0.1), (0.61, 0.12)])  # split by the detector: 1.2 cm apart at 0.6 m
+    assert out.track_id.tolist() == [0, 0] and state.size == 1
+    state, out = _frame(state, [(0.6, 0.1), (0.6, 0.2)])  # 6 cm apart: another robot
+    assert out.track_id.tolist() == [0, 1]
+
+
+def test_a_partly_seen_reading_cannot_bend_the_rate():
+    def run(visible: float) -> float:
+        state = empty_state()
+        for _ in range(20):
+            state, out = update(state, [0.6], [0.1], [0.003], [0.0008], None, P, [1.0])
+        state, out = update(state, [0.6], [0.107], [0.003], [0.0008], None, P, [visible])  # 0.4° off
+        return float(out.bearing_rate_radps[0])
+    assert abs(run(0.45)) < 0.3 * abs(run(1.0))

@@ -19,14 +19,13 @@ CAMERA = CameraIntrinsics()
 
 # (range from, range to, bearing from, bearing to) over the sequence
 Path = Tuple[float, float, float, float]
-# A and B cross at different ranges (A passes in front of B and hides it for a few frames);
-# C and D cross at similar ranges (their bodies just clear each other).
-CROSSINGS: Sequence[Path] = (
-    (0.45, 0.50, 0.32, -0.30),
-    (0.95, 0.90, -0.30, 0.32),
-    (0.62, 0.66, -0.05, 0.40),
-    (0.74, 0.72, 0.42, -0.05),
-)
+# two robots crossing at different ranges: the near one passes in front of the far one and hides it
+APART: Sequence[Path] = ((0.45, 0.50, 0.30, -0.30), (0.95, 0.90, -0.30, 0.30))
+# two robots crossing at similar ranges: their bodies just clear each other, their landmarks touch
+CLOSE: Sequence[Path] = ((0.62, 0.66, -0.25, 0.25), (0.74, 0.72, 0.25, -0.25))
+# both at once, and the near robot of APART crossing the CLOSE pair too (a harder case, not a test)
+CROSSINGS: Sequence[Path] = ((0.45, 0.50, 0.32, -0.30), (0.95, 0.90, -0.30, 0.32),
+                             (0.62, 0.66, -0.05, 0.40), (0.74, 0.72, 0.42, -0.05))
 
 
 def crossing_frames(frames: int, seed: int, paths: Sequence[Path] = CROSSINGS,

@@ -1,9 +1,9 @@
 """Rendered robots crossing in bearing keep their track ids through the pipeline (issue 8).
 
-One 45-frame sequence (1.5 s at 30 fps): robot 0 passes in front of robot 1
-(different ranges, 0.45 vs 0.95 m) and robots 2 and 3 cross at similar ranges
-(0.62-0.74 m), while robot 0 also crosses both. Landmarks hide each other and
-merge in the image on the way.
+Two 36-frame sequences (1.2 s at 30 fps), each of two robots sweeping 0.6 rad
+across each other: at different ranges (0.45 and 0.95 m: the near one hides
+the far one), and at similar ranges (0.62-0.74 m: the landmarks touch and
+merge in the image).
 """
 
 from __future__ import annotations
@@ -20,32 +20,45 @@ from rangebearing.core.types import FrameResult
 from rangebearing.evaluation.identity import id_report, match_identities
 from rangebearing.evaluation.truth import TruthRow
 
-from .crossing import CAMERA, CROSSINGS, FPS, crossing_frames
+from .crossing import APART, CAMERA, CLOSE, FPS, crossing_frames
 
-FRAMES = 45
-
-
-@pytest.fixture(scope="module")
-def sequence() -> List[Tuple[float, np.ndarray, List[TruthRow]]]:
-    return list(crossing_frames(FRAMES, seed=1))
+FRAMES = 36
+Sequence = List[Tuple[float, np.ndarray, List[TruthRow]]]
 
 
-@pytest.fixture(scope="module")
-def results(sequence) -> List[FrameResult]:
+def _run(sequence: Sequence) -> List[FrameResult]:
     pipe = Pipeline(PipelineParams(camera=CAMERA), track=True)
     return [pipe.process(image, t_s=t) for t, image, _ in sequence]
 
 
-def test_crossing_robots_keep_their_ids(sequence, results):
+@pytest.fixture(scope="module")
+def sequence() -> Sequence:
+    return list(crossing_frames(FRAMES, seed=1, paths=APART))
+
+
+@pytest.fixture(scope="module")
+def results(sequence) -> List[FrameResult]:
+    return _run(sequence)
+
+
+def test_robots_crossing_at_different_ranges_keep_their_ids(sequence, results):
     rep = id_report((r.landmarks, truth) for r, (_, _, truth) in zip(results, sequence))
-    assert rep.robots >= 3 and rep.landmark_frames >= 100
+    assert rep.robots == 2 and rep.landmark_frames >= 55, rep
     assert rep.switches == 0, rep
-    assert rep.returns >= 1 and rep.returns_kept == rep.returns, rep
+    assert rep.returns >= 1 and rep.returns_kept == rep.returns, rep  # the far one came back from behind
+
+
+def test_robots_crossing_at_similar_ranges_keep_their_ids():
+    sequence = list(crossing_frames(FRAMES, seed=2, paths=CLOSE))
+    results = _run(sequence)
+    rep = id_report((r.landmarks, truth) for r, (_, _, truth) in zip(results, sequence))
+    assert rep.robots == 2 and rep.landmark_frames >= 55, rep
+    assert rep.switches == 0 and rep.returns_kept == rep.returns, rep
 
 
 def test_published_rates_follow_the_robots(sequence, results):
-    """Robot 0 sweeps 0.62 rad right in 1.5 s: its bearing rate is -0.42 rad/s, its range rate +0.034 m/s."""
-    r0, r1, b0, b1 = CROSSINGS[0]
+    """Robot 0 sweeps 0.6 rad right in 1.2 s: its bearing rate is -0.51 rad/s, its range rate +0.043 m/s."""
+    r0, r1, b0, b1 = APART[0]
     duration = (FRAMES - 1) / FPS
     rates = []
     for result, (_, _, truth) in list(zip(results, sequence))[-15:]:

@@ -70,6 +70,7 @@ class IdentityParams:
     outlier_bearing_rad: float = 0.015
     # a young track (fewer than rate_after_updates readings) yields to an established one it competes with
     young_penalty: float = 10.0  # added to -2 ln(likelihood)
+    twin_width_m: float = 0.035  # a leftover reading this close to a matched one is the same landmark
     nominal_dt_s: float = 1.0 / 30.0  # frame interval when the frames carry no time
     max_dt_s: float = 1.0  # a longer gap is predicted as this long (a paused source)
     rate_after_updates: int = 3  # rates are published from this many measurements on
@@ -118,13 +119,24 @@ class Identified:
 
 
 def measurement_variance(
-    range_m: np.ndarray, range_sigma_m: np.ndarray, bearing_sigma_rad: np.ndarray, params: IdentityParams
+    range_m: np.ndarray, range_sigma_m: np.ndarray, bearing_sigma_rad: np.ndarray, visible: np.ndarray,
+    params: IdentityParams,
 ) -> np.ndarray:
-    """``(m, 2)`` variances of range and bearing readings, sigmas floored by ``params``."""
+    """``(m, 2)`` variances of range and bearing readings, sigmas floored by ``params``.
+
+    A partly seen landmark (``visible`` < 1: hidden in part, or split from a
+    neighbour) is trusted less than its sigmas say: ``(1 - visible)`` times the
+    outlier sigmas are added in quadrature, so one such reading cannot bend a
+    track's rate.
+    """
     r = np.empty((range_m.shape[0], 2))
     np.maximum(range_sigma_m, params.min_range_sigma_frac * np.abs(range_m), out=r[:, RANGE])
     np.maximum(bearing_sigma_rad, params.min_bearing_sigma_rad, out=r[:, BEARING])
-    return np.square(r, out=r)
+    np.square(r, out=r)
+    hidden = np.square(1.0 - np.clip(visible, 0.0, 1.0))
+    r[:, RANGE] += hidden * np.square(params.outlier_range_frac * range_m)
+    r[:, BEARING] += hidden * params.outlier_bearing_rad**2
+    return r
 
 
 def predict(x: np.ndarray, p: np.ndarray, dt_s: float, params: IdentityParams) -> Tuple[np.ndarray, np.ndarray]:
@@ -192,6 +204,23 @@ def _dt(state: IdentityState, t_s: Optional[float], params: IdentityParams) -> f
     return min(dt, params.max_dt_s)
 
 
+def _twins(det_row: np.ndarray, z: np.ndarray, cols: np.ndarray, params: IdentityParams) -> None:
+    """Give a leftover reading that lies on a matched one (within a landmark's width in bearing
+    and ``outlier_range_frac`` in range: the same landmark, seen twice) that reading's track, in place.
+
+    A landmark split in two by the detector is then one neighbour, not a newcomer.
+    """
+    left = np.nonzero(det_row < 0)[0]
+    db = np.abs(z[left, None, BEARING] - z[None, cols, BEARING])
+    rng = z[cols, RANGE][None, :]
+    dr = np.abs(z[left, None, RANGE] - rng)
+    twin = (db <= params.twin_width_m / rng) & (dr <= params.outlier_range_frac * rng)
+    has = twin.any(axis=1)
+    if has.any():
+        nearest = np.argmin(np.where(twin, db, np.inf), axis=1)
+        det_row[left[has]] = det_row[cols[nearest[has]]]
+
+
 def _births(state: IdentityState, z: np.ndarray, r: np.ndarray, params: IdentityParams) -> IdentityState:
     """New tracks for readings ``z`` (``(k, 2)``), ids from the counter on."""
     k = z.shape[0]
@@ -213,6 +242,7 @@ def update(
     bearing_sigma_rad: Sequence[float],
     t_s: Optional[float] = None,
     params: Optional[IdentityParams] = None,
+    visible: Optional[Sequence[float]] = None,
 ) -> Tuple[IdentityState, Identified]:
     """Associate one frame's readings with the tracks; returns the new state and each reading's id and rates.
 
@@ -228,6 +258,8 @@ def update(
         ``params.nominal_dt_s`` apart.
     params : IdentityParams, optional
         Defaults to ``IdentityParams()``.
+    visible : sequence of float, optional
+        Fraction of each landmark seen (0-1); 1 when not given.
 
     Returns
     -------
@@ -242,8 +274,9 @@ def update(
     z[:, RANGE] = range_m
     z[:, BEARING] = bearing_rad
     params = DEFAULT_PARAMS if params is None else params
+    seen = np.ones(m) if visible is None else np.asarray(visible, float)
     r = measurement_variance(z[:, RANGE], np.asarray(range_sigma_m, float), np.asarray(bearing_sigma_rad, float),
-                             params)
+                             seen, params)
     x, p = predict(state.x, state.p, _dt(state, t_s, params), params)
     rw = np.maximum(r, np.square(np.stack([params.outlier_range_frac * z[:, RANGE],
                                            np.full(m, params.outlier_bearing_rad)], axis=1)))
@@ -265,7 +298,9 @@ def update(
     ids, next_id = state.ids, state.next_id
     det_row = np.full(m, -1, dtype=np.intp)
     det_row[cols] = rows
-    if rows.size < m:  # readings no track took: new tracks, appended after the old ones
+    if 0 < rows.size < m:
+        _twins(det_row, z, cols, params)
+    if (det_row < 0).any():  # readings no track took: new tracks, appended after the old ones
         new = np.nonzero(det_row < 0)[0]
         born = _births(state, z[new], r[new], params)
         det_row[new] = ids.shape[0] + np.arange(new.size)
@@ -302,6 +337,7 @@ def identify(
         [lm.bearing_sigma_rad for lm in landmarks],
         t_s,
         params,
+        [lm.visible for lm in landmarks],
     )
     labelled = tuple(
         replace(lm, track_id=int(tid), range_rate_mps=None if rr != rr else float(rr),
