@@ -138,6 +138,27 @@ def test_service_type_and_lifecycle(unit: Unit) -> None:
     assert single(unit, "Install", "WantedBy") == "multi-user.target"
     assert values(unit, "Unit", "StartLimitIntervalSec")
     assert values(unit, "Unit", "StartLimitBurst")
+    assert single(unit, "Service", "RestartPreventExitStatus") == "2"  # config/frame-size errors: no loop
+
+
+def _seconds(unit: Unit, section: str, key: str) -> int:
+    return int(re.fullmatch(r"(\d+)s?", single(unit, section, key)).group(1))  # type: ignore[union-attr]
+
+
+def test_a_camera_fault_can_never_reach_the_start_limit(unit: Unit) -> None:
+    """Item 10: a robot without its camera restarts forever; only an instant crash loop stops."""
+    from rangebearing.config import SourceConfig
+    from rangebearing.config.schema import MAX_CAPTURE_BUDGET_S
+
+    src = SourceConfig()
+    interval, burst = _seconds(unit, "Unit", "StartLimitIntervalSec"), int(single(unit, "Unit", "StartLimitBurst"))
+    restart = _seconds(unit, "Service", "RestartSec")
+    # a start that waits for a missing camera lasts open_timeout_s: never `burst` of them in the interval
+    assert burst * (src.open_timeout_s + restart) > interval
+    # a running daemon's stall ends in its own clean exit, well before the watchdog
+    watchdog = _seconds(unit, "Service", "WatchdogSec")
+    assert src.timeout_s * src.retries <= MAX_CAPTURE_BUDGET_S <= watchdog - 5
+    assert src.open_timeout_s + 10 <= _seconds(unit, "Service", "TimeoutStartSec")
 
 
 @pytest.mark.parametrize(("key", "lo_s", "hi_s"), [("WatchdogSec", 2, 60), ("RestartSec", 2, 30)])

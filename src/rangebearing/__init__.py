@@ -9,10 +9,9 @@
 
 from __future__ import annotations
 
-from .config import Config, load_config
-from .core.params import DetectionParams, ModelParams, PipelineParams
-from .core.pipeline import Pipeline
-from .core.types import CameraIntrinsics, FrameResult, Landmark, LandmarkGeometry
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .errors import (
     CalibrationError,
     CameraError,
@@ -24,6 +23,30 @@ from .errors import (
 )
 
 __version__ = "0.1.0"
+
+# Imported on first use: ``rangebearing run`` must reach its signal handlers before numpy and
+# OpenCV load (see ``_signals``), and ``import rangebearing.errors`` should cost nothing.
+_LAZY = {
+    "Config": ".config", "load_config": ".config",
+    "DetectionParams": ".core.params", "ModelParams": ".core.params", "PipelineParams": ".core.params",
+    "Pipeline": ".core.pipeline",
+    "CameraIntrinsics": ".core.types", "FrameResult": ".core.types", "Landmark": ".core.types",
+    "LandmarkGeometry": ".core.types",
+}
+
+if TYPE_CHECKING:
+    from .config import Config, load_config
+    from .core.params import DetectionParams, ModelParams, PipelineParams
+    from .core.pipeline import Pipeline
+    from .core.types import CameraIntrinsics, FrameResult, Landmark, LandmarkGeometry
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "CalibrationError",

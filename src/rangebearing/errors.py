@@ -33,6 +33,10 @@ class FrameError(RangeBearingError, ValueError):
     """A frame is unusable (wrong shape, wrong dtype, empty, corrupt)."""
 
 
+class FrameShapeError(FrameError):
+    """Frames of a size the configuration cannot serve (another aspect ratio than camera.*): every frame would fail."""
+
+
 class SourceError(RangeBearingError, OSError):
     """A frame source cannot be opened or read."""
 

@@ -24,10 +24,10 @@ def _load(tmp_path: Path, content: str | bytes, name: str = "c.yaml") -> ConfigE
         f.write_bytes(content)
     else:
         f.write_text(content, encoding="utf-8")
-    t0 = time.perf_counter()
+    t0 = time.thread_time()
     with pytest.raises(ConfigError) as info:
         load_config(f)
-    assert time.perf_counter() - t0 < 1.0
+    assert time.thread_time() - t0 < 1.0
     err = info.value
     assert type(err) is ConfigError and str(f) in str(err) and len(str(err)) < 2048
     return err

@@ -147,7 +147,7 @@ def test_picamera2_source_runs_through_the_loop_and_survives_a_capture_timeout(f
     world = fake_picamera2.WORLD
     world.producer = static_rgb
     seen: List[bytes] = []
-    daemon = Daemon(picamera_cfg(), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    daemon = Daemon(picamera_cfg(retries=10), opener, lambda c: MemoryPublisher(), RecordingNotifier())
 
     def echo(payload: bytes) -> None:
         seen.append(payload)
@@ -167,8 +167,11 @@ def test_picamera2_source_runs_through_the_loop_and_survives_a_capture_timeout(f
 
 def test_a_missing_camera_ends_the_run_with_a_failure(fake_picamera2, caplog):
     fake_picamera2.WORLD.num_cameras = 0
-    daemon = Daemon(picamera_cfg(retries=0), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    daemon = Daemon(picamera_cfg(retries=1, open_timeout_s=0.5), opener, lambda c: MemoryPublisher(),
+                    RecordingNotifier())
+    t0 = time.monotonic()
     assert daemon.run() == 1
+    assert time.monotonic() - t0 < 3.0
     assert "no camera 0" in caplog.text
 
 
@@ -176,7 +179,7 @@ def test_a_camera_that_keeps_timing_out_ends_the_run(fake_picamera2, caplog):
     fake_picamera2.WORLD.stalled = True
     daemon = Daemon(picamera_cfg(retries=2), opener, lambda c: MemoryPublisher(), RecordingNotifier())
     assert daemon.run() == 1
-    assert "giving up" in caplog.text
+    assert "exiting for the service manager" in caplog.text
 
 
 def test_reloads_swap_the_publisher_and_survive_a_source_that_will_not_open(static_clip, tmp_path, caplog):

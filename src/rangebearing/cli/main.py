@@ -15,9 +15,10 @@ import importlib
 import logging
 import os
 import sys
+import threading
 from typing import Dict, List, Optional
 
-from .. import __version__
+from .. import __version__, _signals
 from ..errors import ConfigError, RangeBearingError
 
 # name -> one-line help; the module cli/<name>_cmd.py has register(subparsers) and sets func=run.
@@ -107,6 +108,8 @@ def describe_error(exc: BaseException) -> str:
 def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
     args_list = list(sys.argv[1:] if argv is None else argv)
+    if chosen_command(args_list) == "run" and threading.current_thread() is threading.main_thread():
+        _signals.install_early()  # before the heavy imports: a SIGHUP now must not end the daemon
     parser = build_parser(args_list)
     args = parser.parse_args(args_list)
     debug = getattr(args, "debug", False) or os.environ.get("RANGEBEARING_DEBUG", "") not in ("", "0")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+import os
 import sys
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
@@ -94,10 +95,16 @@ def run(args: argparse.Namespace) -> int:
         if cfg.publish.multicast_group:
             dests += f", multicast {cfg.publish.multicast_group}:{cfg.publish.multicast_port}"
         log.info("starting: source %s, publishing to %s", cfg.source.kind, dests or "nowhere")
-        return daemon.run()
+        status = daemon.run()
     finally:
         if view is not None:
             view.close()
+    if daemon.guard.wedged:  # a capture call never returned: its thread would hold the interpreter's exit
+        log.warning("a capture call is still blocked in the camera stack; leaving without waiting for it")
+        logging.shutdown()
+        sys.stdout.flush()
+        os._exit(status)
+    return status
 
 
 def start_view_for(

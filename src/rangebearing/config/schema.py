@@ -37,8 +37,9 @@ class SourceConfig:
     hflip: bool = False
     vflip: bool = False
     buffer_count: int = 4
-    timeout_s: float = 2.0
-    retries: int = 5
+    timeout_s: float = 1.0  # one capture's wait
+    retries: int = 8  # no frame for timeout_s × retries: reopen the camera halfway, give up at the end
+    open_timeout_s: float = 60.0  # at start, how long to wait for a missing or busy camera
     controls: Tuple[Tuple[str, Any], ...] = ()
 
 
@@ -151,6 +152,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "buffer_count": ck.number(1, 16, integer=True),
             "timeout_s": ck.number(above=0, hi=4),
             "retries": ck.number(1, 100, integer=True),
+            "open_timeout_s": ck.number(0, 80),  # the unit's TimeoutStartSec=90s must not cut it short
             "controls": ck.controls,
         },
     ),

@@ -13,7 +13,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from .._compat import frozen
-from ..errors import FrameError
+from ..errors import FrameError, FrameShapeError
 
 XY = Tuple[float, float]
 BBox = Tuple[int, int, int, int]  # x, y, width, height in pixels
@@ -54,7 +54,7 @@ class CameraIntrinsics:
         if (width_px, height_px) == (self.width_px, self.height_px):
             return self
         if abs(width_px * self.height_px - height_px * self.width_px) > 0.01 * width_px * self.height_px:
-            raise FrameError(
+            raise FrameShapeError(
                 f"frame is {width_px}×{height_px} but the camera intrinsics are for {self.width_px}×{self.height_px}, "
                 "another aspect ratio (a cropped sensor mode): configure camera.* for this resolution"
             )

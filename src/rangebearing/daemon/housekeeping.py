@@ -45,7 +45,9 @@ class Housekeeping:
         self._summary = summary
         self.status_interval_ns = int(status_interval_s * 1e9)
         wd = notifier.watchdog_interval_s()
-        self._wd_every_ns = int(wd * 1e9 / 2) if wd else 0  # ping twice per watchdog period
+        # ping at most 1 s after a frame: a stall is then noticed WatchdogSec after its last frame, not
+        # up to half a period earlier, so the daemon's own capture budget always ends it first
+        self._wd_every_ns = int(min(wd / 2, 1.0) * 1e9) if wd else 0
         self.ready = False
         self._last_wd_ns: Optional[int] = None
         self._last_status_ns: Optional[int] = None

@@ -6,7 +6,12 @@ a :class:`~rangebearing.core.pipeline.Pipeline` and a
 READY/WATCHDOG/STATUS live in :mod:`.housekeeping`. The loop always takes the
 source's newest frame (the source counts what it skipped), skips and counts
 bad frames, never lets a network fault through, and on SIGHUP swaps in the
-config that the injected ``reload`` returns, between frames.
+config that the injected ``reload`` returns, between frames; a reload can
+never end the daemon. Camera faults are ridden out by :mod:`.capture`.
+
+Exit status: 0 for the end of a recording or a requested stop (SIGTERM at any
+moment, camera back-off included), 1 when the camera is gone past its budget,
+2 when the frames cannot fit the configuration (another aspect ratio).
 """
 
 from __future__ import annotations
@@ -18,12 +23,14 @@ import threading
 import time
 from typing import TYPE_CHECKING, Any, Callable, Dict, Optional
 
+from .. import _signals
 from ..config import Config
 from ..core.pipeline import Pipeline
-from ..errors import ConfigError, FrameError, ProtocolError, RangeBearingError, SourceError
-from ..net.protocol import encode_reading
+from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
+from ..net.fit import encode_fitting
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource
+from .capture import CameraGone, CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
 from .stats import LoopStats, Summary
 
@@ -83,44 +90,64 @@ class Daemon:
         self.house = Housekeeping(notifier, self.summary, cfg.daemon.status_interval_s)
         self._stop = threading.Event()
         self._reload = threading.Event()
-        self._source: Optional[FrameSource] = None
+        self.guard = self._guard(cfg)
         self._pipe = Pipeline(cfg.pipeline)
         self._publisher: Optional[Publisher] = None
-        self._dropped_before = 0  # drops of sources closed by a reload
+
+    def _guard(self, cfg: Config) -> CaptureGuard:
+        src = cfg.source
+        return CaptureGuard(lambda sleep: self._open_source(cfg, sleep), self._stop, src.timeout_s,
+                            src.timeout_s * src.retries, src.open_timeout_s)
 
     # --- control, safe to call from signal handlers ---------------------------------
     def stop(self) -> None:
         self._stop.set()
+        self.guard.interrupt()
 
     def request_reload(self) -> None:
         self._reload.set()
 
     def install_signal_handlers(self) -> None:
+        """SIGTERM/SIGINT stop, SIGHUP reloads; signals noted while starting (``_signals``) are honoured."""
         signal.signal(signal.SIGTERM, lambda *_: self.stop())
         signal.signal(signal.SIGINT, lambda *_: self.stop())
         signal.signal(signal.SIGHUP, lambda *_: self.request_reload())
+        early = _signals.taken_over()
+        if early["stop"]:
+            log.info("SIGTERM arrived while starting: stopping")
+            self.stop()
+        if early["reload"]:  # the file may have changed after it was read: read it again
+            self.request_reload()
 
     @property
     def dropped(self) -> int:
-        return self._dropped_before + (self._source.dropped if self._source else 0)
+        source = self.guard.source
+        return self.guard.dropped_before + (source.dropped if source else 0)
 
     def summary(self) -> Summary:
         return self.stats.summary(self.dropped)
 
     # --- the loop ---------------------------------------------------------------------
     def run(self) -> int:
-        """Returns 0 when the source ends or a stop was requested, 1 when the source failed."""
+        """0: the source ended or a stop was requested; 1: the camera is gone; 2: frames the config cannot fit."""
         self._publisher = self._open_publisher(self.cfg)
         try:
-            self._source = self._open_source(self.cfg, self._stop.wait)
+            if not self.guard.open():
+                return 0  # stopped while the camera was still being waited for
             return self._loop()
+        except FrameShapeError as exc:  # every frame would fail the same way: say it once, clearly
+            log.error("cannot process these frames: %s", exc)
+            self.house.notifier.status(f"failed: {exc}")
+            return 2
         except SourceError as exc:
+            if self._stop.is_set():  # a requested stop is not a failure, whatever it interrupted
+                return 0
             log.error("frame source failed: %s", exc)
+            self.house.notifier.status(f"failed: {exc}")
             return 1
         finally:
             self.house.stopping()
-            if self._source is not None:
-                self._source.close()
+            self.guard.close()
             self._publisher.close()
             log.info("stopped: %s", self.summary().line())
 
@@ -133,16 +160,19 @@ class Daemon:
                 self._view_thresholds()
             t_read = clock()
             try:
-                frame = self._source.read()  # type: ignore[union-attr]
+                frame = self.guard.read()
                 if frame is None:
-                    log.info("end of stream")
+                    if not self._stop.is_set():
+                        log.info("end of stream")
                     return 0
                 t0 = clock()
                 result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9)
                 t1 = clock()
                 pub = self.cfg.publish
-                payload = encode_reading(pub.robot_id, seq, _unix_time(frame, t1), result.landmarks, self.stats.fps,
-                                         self.dropped)
+                payload = encode_fitting(pub.robot_id, seq, _unix_time(frame, t1), result.landmarks, self.stats.fps,
+                                         self.dropped)  # always one packet: the nearest landmarks if not all fit
+            except FrameShapeError:
+                raise
             except (FrameError, ProtocolError) as exc:  # a bad frame, or a reading that cannot be encoded
                 self._bad_frame(exc)
                 continue
@@ -187,7 +217,19 @@ class Daemon:
             log.warning("%s (%d so far): %s", what, n, exc)
 
     def _do_reload(self) -> None:
-        """Swap in the reloaded config; keep everything as it was if the new one is bad."""
+        """Swap in the reloaded config; keep everything as it was if the new one is bad.
+
+        Nothing a config file holds may end a running daemon: beyond ConfigError, any
+        failure of the reload itself is logged and the running config kept.
+        """
+        try:
+            self._reload_once()
+        except SourceError:
+            raise  # the old camera could not be reopened either: the camera policy decides
+        except Exception as exc:  # deliberately broad: a reload must never end the daemon
+            log.error("reload failed, keeping the running config: %s: %s", type(exc).__name__, str(exc)[:300])
+
+    def _reload_once(self) -> None:
         self._reload.clear()
         self.house.reloading()
         try:
@@ -209,6 +251,8 @@ class Daemon:
             if new.daemon.view_port != self.cfg.daemon.view_port or new.daemon.view_host != self.cfg.daemon.view_host:
                 log.warning("daemon.view_port / view_host changes take effect at the next start")
             self._publisher, self.cfg = new_pub, new
+            src = new.source
+            self.guard.timeout_s, self.guard.budget_s = src.timeout_s, src.timeout_s * src.retries
             if self.view is not None:
                 from ..view.thresholds import Thresholds
 
@@ -221,22 +265,19 @@ class Daemon:
         """Close the running source and open the new config's; on failure reopen the old one and say False.
 
         The old source is closed first: a camera cannot be opened twice. If the
-        old one cannot be reopened either, SourceError ends the run (and systemd
+        old one cannot be reopened either, CameraGone ends the run (and systemd
         restarts the service).
         """
         log.info("camera settings changed: reopening the frame source")
-        old = self._source
-        self._source = None
-        if old is not None:
-            self._dropped_before += old.dropped
-            old.close()
+        self.guard.close()
         try:
-            self._source = self._open_source(new, self._stop.wait)
-            return True
-        except SourceError as exc:
+            if self.guard.open(lambda sleep: self._open_source(new, sleep), budget_s=new.source.timeout_s * 2):
+                return True
+        except CameraGone as exc:
             log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
-            self._source = self._open_source(self.cfg, self._stop.wait)
-            return False
+        old = self.cfg
+        self.guard.open(lambda sleep: self._open_source(old, sleep), budget_s=old.source.open_timeout_s)
+        return False
 
 
 def _unix_time(frame: Frame, now_mono_ns: int) -> float:

@@ -114,7 +114,7 @@ class Picamera2Source:
         sleep: Callable[[float], object] = time.sleep,
         clock: Callable[[], int] = time.monotonic_ns,
         backoff_s: float = 0.5,
-        max_backoff_s: float = 8.0,
+        max_backoff_s: float = 2.0,  # a camera that comes back is found within 2 s
         stop_timeout_s: float = 3.0,
     ) -> None:
         self._cfg = cfg
