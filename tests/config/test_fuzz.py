@@ -1,7 +1,8 @@
 """Config fuzzing: 1,000 mutations of the shipped config through ``load_config`` in-process.
 
 Each either loads or raises ConfigError naming the file, in under a second of CPU time
-(this thread's: other jobs on a shared machine do not count), with a message under 2 KB. Seeded, so a failure names a case that fails again.
+(this thread's: other jobs on a shared machine do not count), with a message under 2 KB.
+Seeded, so a failure names a case that fails again.
 """
 
 from __future__ import annotations
