@@ -52,6 +52,9 @@ class IdentityParams:
     """
 
     max_hidden_frames: int = 15
+    # a glimpse (fewer than rate_after_updates readings) has no rate: after this many frames unseen its
+    # gate covers most of the view and would take the next newcomer's reading
+    max_hidden_young_frames: int = 5
     gate_d2: float = 16.0  # chi-square, 2 dof: a true pair falls outside once in ~3,000
     range_accel_mps2: float = 0.75  # half of a 1.5 m/s² bound
     lateral_accel_mps2: float = 0.75
@@ -234,7 +237,8 @@ def update(
         range_rate_mps=np.where(grown, rates[:, RANGE], np.nan),
         bearing_rate_radps=np.where(grown, rates[:, BEARING], np.nan),
     )
-    keep = hidden <= params.max_hidden_frames
+    limit = np.where(updates >= params.rate_after_updates, params.max_hidden_frames, params.max_hidden_young_frames)
+    keep = hidden <= limit
     if not keep.all():
         ids, x, p, hidden, updates = ids[keep], x[keep], p[keep], hidden[keep], updates[keep]
     return IdentityState(ids, x, p, hidden, updates, next_id, t_s), identified
