@@ -199,7 +199,7 @@ def test_a_frame_with_too_many_landmarks_still_sends_a_heartbeat(fake_picamera2:
     pub = MemoryPublisher()
     daemon = Daemon(cfg(), opener, lambda c: pub, RecordingNotifier())
     real_process = daemon._pipe.process
-    daemon._pipe.process = lambda image: dataclasses.replace(real_process(image), landmarks=crowd)  # type: ignore
+    daemon._pipe.process = lambda image, **kw: dataclasses.replace(real_process(image, **kw), landmarks=crowd)  # type: ignore
     daemon.echo = lambda payload: len(pub.payloads) >= 3 and daemon.stop()
     assert daemon.run() == 0
     for payload in pub.payloads:
