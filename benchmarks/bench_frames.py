@@ -83,12 +83,15 @@ def poses(n: int, cam: CameraIntrinsics, phase: float) -> Tuple[LandmarkPose, ..
     bearing and range on its own phase, a full period every 2π.
     """
     half = cam.hfov_rad / 2.0 - EDGE_RAD
+    # Below 640 px wide the far landmarks come nearer with the width, so that they keep about the image size they
+    # have at 640×480 (1.2 m at 320×240 would be a 2.4 m landmark at 640×480, beyond the detector's 2 m envelope).
+    far_m = max(NEAR_M + 0.2, FAR_M * min(1.0, cam.width_px / 640.0))
     out = []
     for i in range(n):
         centre = half * (1.0 - 2.0 * (i + 0.5) / n)  # left (positive) first
         own = phase + 2.0 * math.pi * i / max(n, 1)
         bearing = centre + DRIFT_RAD * math.sin(own)
-        rng_m = (NEAR_M if i % 2 == 0 else FAR_M) + DRIFT_RANGE_M * math.cos(own)
+        rng_m = (NEAR_M if i % 2 == 0 else far_m) + DRIFT_RANGE_M * math.cos(own)
         out.append(LandmarkPose(rng_m, bearing))
     return tuple(out)
 
