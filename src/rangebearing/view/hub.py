@@ -122,7 +122,9 @@ class ViewHub:
         job = _Job(image, name, result, detection, status, time.time())
         with self._lock:
             self._job = job
-            self._next_ns = now_ns + self._interval_ns
+            # on a fixed grid, so a 30 fps camera gives 10 fps, not every fourth frame (7.5 fps); after a gap, anew
+            late = now_ns - self._next_ns >= self._interval_ns
+            self._next_ns = now_ns + self._interval_ns if late else self._next_ns + self._interval_ns
             self._new_job.notify()
 
     def take_thresholds(self) -> Optional[Thresholds]:
