@@ -19,6 +19,7 @@ import argparse
 import http.client
 import os
 import socket
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -123,7 +124,8 @@ def run_phase(
 
 def main(argv: Optional[List[str]] = None) -> int:
     p = argparse.ArgumentParser(prog="bench_view.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--seconds", type=float, default=20.0, help="measuring time per phase")
+    p.add_argument("--seconds", type=float, default=10.0, help="measuring time per phase and repeat")
+    p.add_argument("--repeats", type=int, default=3, help="rounds of all four phases, interleaved (median shown)")
     p.add_argument("--fps", type=float, default=30.0, help="the recorded source's pace (a Pi camera's 30 fps)")
     p.add_argument("--view-fps", type=float, default=10.0, help="daemon.view_fps")
     args = p.parse_args(argv)
@@ -133,14 +135,20 @@ def main(argv: Optional[List[str]] = None) -> int:
         ("one viewer: stream + events", True, ["/stream.mjpg", "/api/events"]),
         ("one viewer with masks", True, ["/stream.mjpg", "/api/events", "/stream.mjpg?layer=masks"]),
     ]
-    print(f"640×480 bundled clip at {args.fps:g} fps, view capped at {args.view_fps:g} fps, "
-          f"{args.seconds:g} s per phase; CPU of the daemon process (all threads), % of one core\n")
-    print("| phase | daemon CPU | frames/s to the viewer |")
-    print("|---|---|---|")
+    print(f"640×480 bundled clip at {args.fps:g} fps, view capped at {args.view_fps:g} fps, {args.seconds:g} s per "
+          f"phase, {args.repeats} interleaved rounds; CPU of the daemon process (all threads), % of one core\n")
+    got: List[List[Tuple[float, float]]] = [[] for _ in phases]
     with tempfile.TemporaryDirectory() as tmp:
-        for name, view, streams in phases:
-            cpu, rate = run_phase(Path(tmp), args.fps, args.view_fps, args.seconds, view, streams)
-            print(f"| {name} | {cpu:.1f} % | {rate:.1f} |" if streams else f"| {name} | {cpu:.1f} % | – |", flush=True)
+        for r in range(args.repeats):
+            for i, (name, view, streams) in enumerate(phases):
+                got[i].append(run_phase(Path(tmp), args.fps, args.view_fps, args.seconds, view, streams))
+                print(f"round {r + 1}: {name}: {got[i][-1][0]:.1f} %", file=sys.stderr, flush=True)
+    print("| phase | daemon CPU, median (min–max) | frames/s to the viewer |")
+    print("|---|---|---|")
+    for (name, _, streams), runs in zip(phases, got):
+        cpu = sorted(c for c, _ in runs)
+        rate = f"{statistics.median(f for _, f in runs):.1f}" if streams else "–"
+        print(f"| {name} | {statistics.median(cpu):.1f} % ({cpu[0]:.1f}–{cpu[-1]:.1f}) | {rate} |")
     return 0
 
 
