@@ -60,7 +60,7 @@ def _robot(lm: LandmarkPose, body: RobotBody, lens: float, ident: int) -> List[P
     # the robot's own camera looks out from the front edge, on a bracket, at ``lens``
     front = c + (body.length_m / 2 - 0.008) * f
     box(front - 0.004 * f, 0.002, 0.002, top, lens - 0.008, ROBOT_BODY)
-    box(front, 0.003, 0.009, lens - 0.008, lens + 0.008, body.board_colour)
+    box(front, 0.003, 0.009, lens - 0.008, lens + 0.008, body.camera_colour)
     if lm.base_height_m > top + 1e-4:
         out.append(Cyl(lm.x_m, lm.z_m, body.mast_radius_m, top, lm.base_height_m,
                        np.array([top]), np.array([body.mast_colour]), np.array(body.mast_colour),

@@ -26,6 +26,7 @@ MAST_COLOURS = {
     "grey": (0.22, 0.22, 0.23),
 }
 BOARD_COLOURS = ((0.05, 0.16, 0.07), (0.03, 0.05, 0.12), (0.04, 0.04, 0.04), (0.12, 0.02, 0.02))
+CAMERA_COLOURS = ((0.05, 0.16, 0.07), (0.04, 0.04, 0.04))  # Pi camera boards: green or black
 CLEARANCE_M = 0.01
 OWN_FOOTPRINT_M = 0.07  # the camera robot itself
 
@@ -35,8 +36,9 @@ def zumo(rng: np.random.Generator) -> RobotBody:
     mast = d.jitter(rng, d.pick(rng, MAST_COLOURS), 0.01)
     board: RGB = BOARD_COLOURS[int(rng.integers(len(BOARD_COLOURS)))]
     black = d.uniform(rng, 0.02, 0.06)
+    camera = CAMERA_COLOURS[int(rng.integers(len(CAMERA_COLOURS)))]
     return RobotBody(mast_radius_m=d.uniform(rng, 0.008, 0.017), mast_colour=mast,
-                     board_colour=d.jitter(rng, board, 0.01),
+                     board_colour=d.jitter(rng, board, 0.01), camera_colour=d.jitter(rng, camera, 0.01),
                      chassis_colour=(black, black, black * 1.05),
                      track_colour=(black * 0.7, black * 0.7, black * 0.7))
 

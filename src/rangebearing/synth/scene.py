@@ -54,6 +54,7 @@ class RobotBody:
     board_colour: RGB = (0.05, 0.16, 0.07)
     blade_colour: RGB = (0.50, 0.50, 0.52)
     mast_colour: RGB = (0.04, 0.04, 0.045)
+    camera_colour: RGB = (0.05, 0.16, 0.07)
 
     @property
     def footprint_m(self) -> float:
