@@ -76,7 +76,7 @@ def test_plot_puts_landmarks_at_the_measured_bearings(page) -> None:
         """() => { const c = document.getElementById('plot').dataset;
         return { ox: +c.originX, oy: +c.originY, rows: [...document.querySelectorAll('#readings tbody tr')]
           .map(r => ({ x: +r.dataset.xPx, y: +r.dataset.yPx, bearing: +r.dataset.bearingRad,
-                       range: +r.dataset.rangeM, frame: r.dataset.frame })) }; }"""
+                       range: +r.dataset.rangeM, frame: r.dataset.frame, track: +r.dataset.trackId })) }; }"""
     )
     rows = sorted(plotted["rows"], key=lambda r: r["bearing"])
     assert len(rows) == 2
@@ -90,6 +90,7 @@ def test_plot_puts_landmarks_at_the_measured_bearings(page) -> None:
         assert shown == pytest.approx(lm.bearing_rad, abs=math.radians(0.3))
         assert shown == pytest.approx(truth, abs=math.radians(0.5))
         assert row["range"] == pytest.approx(lm.range_m, rel=0.02)
+    assert sorted(r["track"] for r in rows) == sorted({r["track"] for r in rows}) and min(r["track"] for r in rows) >= 0
     left, right = rows[1], rows[0]
     assert left["bearing"] > 0 > right["bearing"] and left["x"] < plotted["ox"] < right["x"]  # left is left
 

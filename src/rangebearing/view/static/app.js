@@ -100,6 +100,7 @@ function fillTable(state, s) {
       sig(lm.range_sigma_m, (v) => `${(v * 1000).toFixed(1)} mm`),
       sig(lm.bearing_sigma_rad, (v) => `${deg(v).toFixed(2)}°`),
       `${Math.round(lm.visible * 100)} %`,
+      lm.range_rate_mps === null ? "–" : `${lm.range_rate_mps >= 0 ? "+" : ""}${(lm.range_rate_mps * 1000).toFixed(0)} mm/s`,
     ]) tr.insertCell().textContent = text;
   }
 }
