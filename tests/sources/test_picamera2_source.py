@@ -8,6 +8,7 @@ import time
 from types import ModuleType
 from typing import Any, Iterator, List
 
+import cv2
 import numpy as np
 import pytest
 
@@ -50,7 +51,7 @@ def world(fake_picamera2: ModuleType) -> Any:
 
 @pytest.fixture
 def opened(world: Any) -> Iterator[Picamera2Source]:
-    source = Picamera2Source(make_cfg(), sleep=Sleeps())
+    source = Picamera2Source(make_cfg(), sleep=Sleeps(), in_place=True)
     source.open()
     yield source
     source.close()
@@ -121,6 +122,8 @@ class TestFrames:
         try:
             cam = world.instances[0]
             frame = source.read()
+            assert frame is not None
+            left, right = frame.image[0, 0].tolist(), frame.image[0, -1].tolist()  # valid until the next read
         finally:
             source.close()
         config = cam.camera_config
@@ -129,9 +132,8 @@ class TestFrames:
         assert config["controls"]["FrameDurationLimits"] == (50000, 50000)
         assert config["controls"]["ExposureTime"] == 24000
         assert config["transform"].hflip and not config["transform"].vflip
-        assert frame is not None
-        assert frame.image[0, 0].tolist() == [255, 0, 0]  # flipped: blue on the left (BGR)
-        assert frame.image[0, -1].tolist() == [0, 0, 255]
+        assert left == [255, 0, 0]  # flipped: blue on the left (BGR)
+        assert right == [0, 0, 255]
 
     def test_timestamps_follow_the_sensor(self, world: Any, opened: Picamera2Source) -> None:
         frames = [opened.read() for _ in range(4)]
@@ -163,7 +165,60 @@ class TestFrames:
     def test_every_request_is_released(self, world: Any, opened: Picamera2Source) -> None:
         for _ in range(10):  # more than buffer_count: a leak would stall the fake
             assert opened.read() is not None
+            assert len(world.outstanding) == 1  # only the frame just returned is held
+        opened.close()
         assert world.outstanding == []
+
+
+class TestLores:
+    def test_main_and_lores_are_configured_as_picamera2_wants(self, world: Any, opened: Picamera2Source,
+                                                              fake_picamera2: ModuleType) -> None:
+        config = world.instances[0].camera_config
+        assert config["lores"]["format"] == "YUV420" and config["lores"]["size"] == (W, H)
+        assert config["lores"]["stride"] == 64  # rows padded to the ISP's 64 bytes
+        assert config["colour_space"].name == "SMPTE170M"  # the matrix the search's table assumes
+
+    def test_lores_planes_are_the_frame_in_yuv420_read_in_place(self, world: Any, opened: Picamera2Source) -> None:
+        world.producer = lambda seq, h, w: np.random.default_rng(seq).integers(0, 256, (h, w, 3), np.uint8)
+        frame = opened.read()
+        assert frame is not None and frame.lores_yuv420 is not None
+        yuv = frame.lores_yuv420
+        want = cv2.cvtColor(frame.image, cv2.COLOR_BGR2YUV_I420).reshape(-1)
+        n = (W // 2) * (H // 2)
+        assert yuv.y.shape == (H, W) and yuv.u.shape == yuv.v.shape == (H // 2, W // 2)
+        assert np.array_equal(yuv.y.reshape(-1), want[: W * H])  # no stride padding (77) leaks in
+        assert np.array_equal(yuv.u.reshape(-1), want[W * H: W * H + n])
+        assert np.array_equal(yuv.v.reshape(-1), want[W * H + n:])
+        before = frame.image.copy()
+        opened.read()
+        # the camera has the buffers back: views, not copies, and released at the next read
+        assert (frame.image == 0xEE).all() and (yuv.u == 0xEE).all() and not (before == 0xEE).all()
+
+    def test_lores_off_means_main_only(self, world: Any) -> None:
+        source = Picamera2Source(make_cfg(lores=False))
+        source.open()
+        try:
+            frame = source.read()
+            assert world.instances[0].camera_config["lores"] is None
+            assert frame is not None and frame.lores_yuv420 is None
+        finally:
+            source.close()
+
+    @pytest.mark.parametrize("old_picamera2", [False, True])
+    def test_frames_to_keep_are_copies(self, world: Any, fake_picamera2: ModuleType,
+                                       monkeypatch: pytest.MonkeyPatch, old_picamera2: bool) -> None:
+        if old_picamera2:
+            monkeypatch.delattr(fake_picamera2, "MappedArray")  # picamera2 before MappedArray: make_array
+        source = Picamera2Source(make_cfg())  # not in place: the caller keeps frames (tune, record)
+        source.open()
+        try:
+            first = source.read()
+            assert world.outstanding == []  # released at once
+            source.read()
+        finally:
+            source.close()
+        assert first is not None and first.lores_yuv420 is not None
+        assert not (first.image == 0xEE).any() and not (first.lores_yuv420.v == 0xEE).any()
 
 
 class TestTimeouts:
@@ -177,7 +232,7 @@ class TestTimeouts:
         world.set_stalled(False)
         frame = opened.read()
         assert frame is not None and frame.index == 1
-        assert world.outstanding == []
+        assert len(world.outstanding) == 1  # the frame just returned; the timed-out job leaked none
 
     def test_consecutive_timeouts_become_a_camera_error(
         self, world: Any, opened: Picamera2Source

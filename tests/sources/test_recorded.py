@@ -295,3 +295,25 @@ def test_looping_frames_are_cached_but_not_shared(tmp_path: Path) -> None:
     again = source.read()
     assert again is not None and again.name == first.name
     assert frame_brightness(again.image) == 5
+
+
+def test_lores_is_the_frame_in_yuv420_and_is_kept_when_looping(static_clip):
+    from rangebearing.core.yuv import yuv420_from_bgr
+
+    source = RecordedSource(static_clip, loop=True, lores=True)
+    source.open()
+    try:
+        frames = [source.read() for _ in range(14)]  # 12 files: the last two come round again
+    finally:
+        source.close()
+    first, again = frames[0], frames[12]
+    assert first is not None and again is not None and first.lores_yuv420 is not None
+    want = yuv420_from_bgr(first.image)
+    assert np.array_equal(first.lores_yuv420.u, want.u) and np.array_equal(first.lores_yuv420.y, want.y)
+    assert again.lores_yuv420 is first.lores_yuv420  # converted once, like a camera's free stream
+    plain = RecordedSource(static_clip)
+    plain.open()
+    try:
+        assert plain.read().lores_yuv420 is None  # type: ignore[union-attr]
+    finally:
+        plain.close()

@@ -42,7 +42,7 @@ def register(sub: Any) -> None:
 
 
 def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
-    return open_source(cfg.source, cfg.camera, sleep=sleep)
+    return open_source(cfg.source, cfg.camera, sleep=sleep, in_place=True)  # the loop is done with each frame
 
 
 def publisher_for(cfg: Config) -> UdpPublisher:

@@ -41,6 +41,7 @@ class SourceConfig:
     retries: int = 8  # no frame for timeout_s × retries: reopen the camera halfway, give up at the end
     open_timeout_s: float = 60.0  # at start, how long to wait for a missing or busy camera
     controls: Tuple[Tuple[str, Any], ...] = ()
+    lores: bool = True  # picamera2: a YUV420 lores stream beside main, searched for bands (the ISP makes it)
 
 
 @frozen
@@ -154,6 +155,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "retries": ck.number(1, 100, integer=True),
             "open_timeout_s": ck.number(0, 80),  # the unit's TimeoutStartSec=90s must not cut it short
             "controls": ck.controls,
+            "lores": ck.boolean,
         },
     ),
     "publish": (

@@ -16,6 +16,7 @@ import numpy as np
 
 from .._compat import frozen
 from ..core.types import check_frame
+from ..core.yuv import Yuv420, yuv420_from_bgr
 from ..errors import FrameError
 
 
@@ -28,12 +29,30 @@ class Frame:
     the source has one. ``index`` is the source's own 0-based frame counter, so a
     gap means frames were dropped upstream. ``name`` is the file name for image
     directories and ``str(index)`` (the position in the file) otherwise.
+
+    ``lores_yuv420`` is the camera's second, YUV420 stream of the same view
+    (Picamera2's ``lores``), where the source has one: the pipeline searches
+    for bands on it and measures on ``image``. A camera's arrays may be views
+    into its buffers, valid until the source's next ``read()`` or ``close()``.
     """
 
     image: np.ndarray
     t_mono_ns: int
     index: int
     name: str
+    lores_yuv420: Optional[Yuv420] = None
+
+
+def with_lores(frame: Frame) -> Frame:
+    """``frame`` with the YUV420 stream a camera would deliver beside it (OpenCV's I420 of the BGR image).
+
+    For recorded and synthetic sources, so they feed the pipeline as the Pi
+    camera does; frames of odd width or height are returned unchanged.
+    """
+    h, w = frame.image.shape[:2]
+    if frame.lores_yuv420 is not None or h % 2 or w % 2:
+        return frame
+    return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv420_from_bgr(frame.image))
 
 
 @runtime_checkable

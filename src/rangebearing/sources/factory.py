@@ -15,7 +15,7 @@ from .base import FrameSource, Sleep
 
 
 def open_source(
-    cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep = time.sleep
+    cfg: SourceConfig, camera: CameraIntrinsics, sleep: Sleep = time.sleep, in_place: bool = False
 ) -> FrameSource:
     """Build the source ``cfg.kind`` names, open it and return it.
 
@@ -24,7 +24,10 @@ def open_source(
     calls ``open()`` again is harmless. The caller owns the source and must
     ``close()`` it. ``sleep`` paces recorded and synthetic frames and spaces
     camera retries; pass ``threading.Event.wait`` so that setting the event
-    cuts any wait short (a sleep that returns True ends the wait).
+    cuts any wait short (a sleep that returns True ends the wait). ``in_place``
+    lets the camera hand over views into its buffers, valid until the next
+    ``read()``: for a caller that is done with each frame before the next (the
+    daemon).
 
     Raises
     ------
@@ -36,7 +39,7 @@ def open_source(
     if cfg.kind == "recorded":
         from .recorded import RecordedSource
 
-        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep)
+        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep, lores=cfg.lores)
     elif cfg.kind == "opencv":
         from .opencv_capture import OpenCVSource
 
@@ -47,7 +50,7 @@ def open_source(
     elif cfg.kind == "picamera2":
         from .picamera2_source import Picamera2Source
 
-        source = Picamera2Source(cfg, sleep=sleep)
+        source = Picamera2Source(cfg, sleep=sleep, in_place=in_place)
     elif cfg.kind == "synthetic":
         from .synthetic import SyntheticSource
 

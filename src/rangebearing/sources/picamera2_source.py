@@ -15,6 +15,16 @@ request.py, job.py) and the manual "The Picamera2 Library":
 * ``"RGB888"`` pixels are stored [B, G, R] (request.py maps RGB888 to PIL mode
   "BGR"), i.e. already OpenCV order: no channel swap here.
 * Every request must be released or the camera runs out of buffers.
+* ``lores`` (the manual's "lores" stream; YUV420 only on Pi 4 and earlier):
+  requested at the main size, so its U and V planes are at half resolution,
+  the pipeline's search scale. Colour space SMPTE 170M (BT.601 limited range)
+  is set explicitly: picamera2 would pick Rec709 from 1280×720 up.
+* Buffers are read in place with ``MappedArray`` (request.py), not with
+  ``make_array``, which copies the whole frame. With ``in_place=True`` (the
+  daemon) the request is held until the next ``read()`` (or ``close()``), so
+  a frame's arrays are views into camera memory valid until then, and at most
+  one request is held; otherwise the frame is copied out and the request
+  released at once (callers that keep frames, e.g. ``tune``).
 """
 
 from __future__ import annotations
@@ -29,6 +39,7 @@ from typing import Any, Callable, Dict, Optional
 import numpy as np
 
 from ..config import SourceConfig
+from ..core.yuv import Yuv420, yuv420_planes
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
 from .faults import TimeoutBudget
@@ -116,15 +127,20 @@ class Picamera2Source:
         backoff_s: float = 0.5,
         max_backoff_s: float = 2.0,  # a camera that comes back is found within 2 s
         stop_timeout_s: float = 3.0,
+        in_place: bool = False,
     ) -> None:
         self._cfg = cfg
+        self._in_place = in_place
         self._sleep = sleep
         self._clock = clock
         self._backoff_s = backoff_s
         self._max_backoff_s = max_backoff_s
         self._stop_timeout_s = stop_timeout_s
         self._cam: Any = None
+        self._mapped: Any = None  # picamera2.MappedArray, or None (very old picamera2: make_array copies)
+        self._held: Any = None  # (request, [entered MappedArrays]) of the frame last returned
         self._width = cfg.width_px
+        self._lores_size: Optional[tuple] = None
         self._boot_offset_ns = 0
         self._prev_sensor_ns: Optional[int] = None
         self._next_index = 0
@@ -157,17 +173,24 @@ class Picamera2Source:
         picamera2 = _import("picamera2")
         libcamera = _import("libcamera")
         cam = self._acquire(picamera2.Picamera2)
+        self._mapped = getattr(picamera2, "MappedArray", None)
         cfg = self._cfg
+        size = (cfg.width_px, cfg.height_px)
         try:
             config = cam.create_video_configuration(
-                main={"format": "RGB888", "size": (cfg.width_px, cfg.height_px)},
+                main={"format": "RGB888", "size": size},
+                lores={"format": "YUV420", "size": size} if cfg.lores else None,
+                colour_space=libcamera.ColorSpace.Smpte170m(),
                 controls=camera_controls(cfg),
                 transform=libcamera.Transform(hflip=cfg.hflip, vflip=cfg.vflip),
                 buffer_count=cfg.buffer_count,
             )
             cam.configure(config)
-            # picamera2 may round the size; make_array's rows are cropped to this width.
-            self._width = int(cam.camera_configuration()["main"]["size"][0])
+            # picamera2 may round the sizes; rows are cropped to these widths.
+            active = cam.camera_configuration()
+            self._width = int(active["main"]["size"][0])
+            lores = active.get("lores")
+            self._lores_size = tuple(int(x) for x in lores["size"]) if lores else None
             cam.start()
         except (RuntimeError, ValueError, KeyError, TypeError) as exc:
             self._cam = cam
@@ -208,10 +231,14 @@ class Picamera2Source:
             return "none"
 
     def read(self) -> Optional[Frame]:
-        """The newest frame; FrameError on a timeout, CameraError on ``cfg.retries`` in a row."""
+        """The newest frame; FrameError on a timeout, CameraError on ``cfg.retries`` in a row.
+
+        With ``in_place`` the frame's arrays stay valid until the next ``read()`` or ``close()``.
+        """
         cam = self._cam
         if cam is None:
             raise SourceError("Picamera2 source is not open")
+        self._release_held()  # the last frame is done with: its buffers go back to the camera
         try:
             request = cam.capture_request(wait=self._cfg.timeout_s)
         except _TIMEOUTS:
@@ -219,26 +246,69 @@ class Picamera2Source:
         except (RuntimeError, concurrent.futures.CancelledError) as exc:
             raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc}") from exc
         received_ns = self._clock()
+        maps: list = []
+        self._held = (request, maps)
         try:
-            array = request.make_array("main")
+            array = self._array(request, "main", maps)
+            lores = self._array(request, "lores", maps) if self._lores_size else None
             metadata = request.get_metadata()
         except (RuntimeError, ValueError) as exc:
+            self._release_held()
             raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
-        finally:
-            request.release()
         self._budget.frame_arrived()
         self._metadata = metadata
         if isinstance(array, np.ndarray) and array.ndim == 3:
             array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
-        image = validate_frame(array)
-        return self._stamp(image, metadata, received_ns)
+        image = validate_frame(array)  # a view when the buffer is contiguous, else one copy
+        search = self._planes(lores)
+        if not self._in_place:  # the caller may keep the frame: copy it out, give the buffers back now
+            image = image.copy() if not image.flags.owndata else image
+            if search is not None:
+                search = Yuv420(search.y.copy(), search.u.copy(), search.v.copy(), search.colour_space)
+            self._release_held()
+        return self._stamp(image, search, metadata, received_ns)
+
+    def _array(self, request: Any, stream: str, maps: list) -> np.ndarray:
+        """The stream's buffer in place (MappedArray, kept mapped until release), or make_array's copy."""
+        if self._mapped is None:
+            return request.make_array(stream)
+        m = self._mapped(request, stream, write=False)
+        m.__enter__()
+        maps.append(m)
+        return m.array
+
+    def _planes(self, lores: Optional[np.ndarray]) -> Optional[Yuv420]:
+        if lores is None or self._lores_size is None:
+            return None
+        w, h = self._lores_size
+        try:
+            return yuv420_planes(lores, w, h, "smpte170m")
+        except ValueError as exc:  # an odd buffer: search the main image instead
+            _log.debug("camera %d: lores unusable: %s", self._cfg.camera_num, exc)
+            return None
+
+    def _release_held(self) -> None:
+        held, self._held = self._held, None
+        if held is None:
+            return
+        request, maps = held
+        for m in maps:
+            try:
+                m.__exit__(None, None, None)
+            except Exception as exc:  # keep releasing: the buffer must go back
+                _log.warning("camera %d: unmapping failed: %s", self._cfg.camera_num, exc)
+        try:
+            request.release()
+        except RuntimeError as exc:
+            _log.warning("camera %d: release failed: %s", self._cfg.camera_num, exc)
 
     def _timed_out(self, cam: Any) -> Exception:
         # The timed-out job is still queued: flush it before it swallows a frame.
         cam.cancel_all_and_flush()
         return self._budget.timed_out()
 
-    def _stamp(self, image: np.ndarray, metadata: Dict[str, Any], received_ns: int) -> Frame:
+    def _stamp(self, image: np.ndarray, search: Optional[Yuv420], metadata: Dict[str, Any],
+               received_ns: int) -> Frame:
         sensor_ns = metadata.get("SensorTimestamp")
         if sensor_ns is None:
             t_ns = received_ns
@@ -254,13 +324,14 @@ class Picamera2Source:
             self._prev_sensor_ns = sensor_ns
         index = self._next_index
         self._next_index += 1
-        return Frame(image=image, t_mono_ns=t_ns, index=index, name=str(index))
+        return Frame(image=image, t_mono_ns=t_ns, index=index, name=str(index), lores_yuv420=search)
 
     def close(self) -> None:
         """Flush, stop and close the camera, waiting at most ``stop_timeout_s``."""
         cam, self._cam = self._cam, None
         if cam is None:
             return
+        self._release_held()
         done = threading.Event()
 
         def shut_down() -> None:

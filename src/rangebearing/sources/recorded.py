@@ -9,8 +9,9 @@ from typing import Callable, Dict, Iterator, List, Optional, Tuple, Union
 import cv2
 import numpy as np
 
+from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
-from .base import Frame
+from .base import Frame, with_lores
 from .pacing import Pacer
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
@@ -183,7 +184,9 @@ class RecordedSource:
     the consumer reads and never drops. ``loop`` restarts at the end;
     ``Frame.index`` keeps counting across loops while ``Frame.name`` names the
     file (or the position in the video). ``clock`` (ns) and ``sleep`` (s) are
-    injectable so tests can pace without real time passing.
+    injectable so tests can pace without real time passing. ``lores`` adds the
+    YUV420 stream a Pi camera delivers beside each frame (OpenCV's I420 of
+    it; kept with the decoded frame when looping, as the ISP makes it for free).
     """
 
     def __init__(
@@ -193,9 +196,12 @@ class RecordedSource:
         loop: bool = False,
         clock: Callable[[], int] = time.monotonic_ns,
         sleep: Callable[[float], object] = time.sleep,
+        lores: bool = False,
     ) -> None:
         self._path = path
         self._loop = loop
+        self._lores = lores
+        self._yuv: Dict[str, Yuv420] = {}  # by frame name, when looping
         self._clock = clock
         self._pacer = Pacer(float(fps), clock, sleep) if fps else None
         self._reader: Union[_ImageDir, _Video, None] = None
@@ -254,7 +260,17 @@ class RecordedSource:
         if image is None:
             raise FrameError(f"{name}: cannot decode image")
         t_ns = self._pacer.capture_ns(i) if self._pacer is not None else self._clock()
-        return Frame(image=image, t_mono_ns=t_ns, index=i, name=name)
+        frame = Frame(image=image, t_mono_ns=t_ns, index=i, name=name)
+        return self._with_lores(frame) if self._lores else frame
+
+    def _with_lores(self, frame: Frame) -> Frame:
+        yuv = self._yuv.get(frame.name)
+        if yuv is None:
+            frame = with_lores(frame)
+            if self._loop and frame.lores_yuv420 is not None and len(self._yuv) * frame.image.nbytes < _CACHE_BYTES:
+                self._yuv[frame.name] = frame.lores_yuv420
+            return frame
+        return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 
     def _fetch(
         self, reader: Union[_ImageDir, _Video], i: int

@@ -19,7 +19,7 @@ from ..core.types import CameraIntrinsics
 from ..errors import FrameError, SourceError
 from ..synth.render import render
 from ..synth.scene import LandmarkPose, Scene
-from .base import Frame
+from .base import Frame, with_lores
 from .pacing import Pacer
 
 Path = Callable[[float], Tuple[LandmarkPose, ...]]
@@ -61,6 +61,7 @@ class SyntheticSource:
         self._scene = dataclasses.replace(scene or Scene(), camera=camera)
         self._path = path
         self._fps = cfg.fps if cfg.fps > 0 else 30.0
+        self._lores = cfg.lores  # the YUV420 stream a Pi camera adds beside each frame
         self._frames = frames
         self._seed = seed
         self._clock = clock
@@ -101,7 +102,8 @@ class SyntheticSource:
         scene = dataclasses.replace(self._scene, landmarks=self.truth(i))
         image = render(scene, self._rng)
         t_ns = self._pacer.capture_ns(i) if self._pacer is not None else self._clock()
-        return Frame(image=image, t_mono_ns=t_ns, index=i, name=str(i))
+        frame = Frame(image=image, t_mono_ns=t_ns, index=i, name=str(i))
+        return with_lores(frame) if self._lores else frame
 
     def close(self) -> None:
         self._rng = None

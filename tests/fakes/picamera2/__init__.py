@@ -13,7 +13,20 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
 * ``"RGB888"`` arrays are [B, G, R] per pixel, ``"BGR888"`` [R, G, B],
   ``"XBGR8888"`` [R, G, B, 255], ``"XRGB8888"`` [B, G, R, 255].
 * Requests are reference counted and hold one of ``buffer_count`` buffers;
-  when all are held, no frame can complete (the camera stalls).
+  when all are held, no frame can complete (the camera stalls). A released
+  request's buffers go back to the camera, which writes the next frames into
+  them: the fake fills them with 0xEE, so a view kept past ``release()`` shows it.
+* ``lores`` (picamera2.py ``create_video_configuration``): a second stream,
+  defaults ``{"format": "YUV420", "size": main size, "preserve_ar": False}``,
+  no larger than main and YUV only (the Pi 4 ISP, VC4). Its buffer is I420:
+  Y (H rows), then U and V (H/2 rows of stride/2 bytes each), the stride
+  rounded up to 64 bytes (the padding holds junk, 77). ``MappedArray(request,
+  "lores")`` gives it as a (H·3/2, stride) array, as ``_make_array_shared``
+  does; the content is the main stream's scaled to the lores size, encoded as
+  OpenCV's ``COLOR_BGR2YUV_I420`` (SMPTE 170M, libcamera's default colour
+  space for video below 1280×720).
+* ``MappedArray(request, stream)`` maps the buffer in place (no copy, unlike
+  ``make_array``); mapping a released request fails.
 
 * ``set_controls()`` takes effect ``WORLD.control_latency_frames`` frames
   later (libcamera applies controls a few frames on); ``ExposureTime`` or
@@ -37,10 +50,11 @@ import time
 from concurrent.futures import CancelledError, Future, TimeoutError
 from typing import Any, Callable, Dict, List, Optional
 
+import cv2
 import libcamera
 import numpy as np
 
-__all__ = ["WORLD", "CancelledError", "CompletedRequest", "Picamera2", "TimeoutError", "shutdown"]
+__all__ = ["WORLD", "CancelledError", "CompletedRequest", "MappedArray", "Picamera2", "TimeoutError", "shutdown"]
 
 _KNOWN_CONTROLS = {
     "AeEnable", "ExposureTime", "AnalogueGain", "AwbEnable", "AwbMode", "ColourGains",
@@ -109,10 +123,13 @@ def shutdown() -> None:
 class CompletedRequest:
     """A frame's buffers and metadata; must be released exactly once."""
 
-    def __init__(self, picam2: Picamera2, image: np.ndarray, metadata: Dict[str, Any]) -> None:
+    def __init__(self, picam2: Picamera2, image: np.ndarray, metadata: Dict[str, Any],
+                 lores: Optional[np.ndarray] = None) -> None:
         self.picam2 = picam2
         self.ref_count = 1
-        self._image: Optional[np.ndarray] = image
+        self._buffers: Optional[Dict[str, np.ndarray]] = {"main": image}
+        if lores is not None:
+            self._buffers["lores"] = lores
         self._metadata = metadata
         self.config = dict(picam2.camera_config)
 
@@ -128,20 +145,51 @@ class CompletedRequest:
             if self.ref_count < 0:
                 raise RuntimeError("CompletedRequest: lock now has negative ref_count")
             if self.ref_count == 0:
-                self._image = None
+                for buf in (self._buffers or {}).values():
+                    buf.fill(0xEE)  # back to the camera, which writes the next frames into it
+                self._buffers = None
                 if self in WORLD.outstanding:
                     WORLD.outstanding.remove(self)
                 self.picam2._pump()
 
-    def make_array(self, name: str) -> np.ndarray:
-        if name != "main":
+    def _shared(self, name: str) -> np.ndarray:
+        """The stream's buffer as picamera2's ``_make_array_shared`` shapes it: no copy."""
+        if self.config.get(name) is None:
             raise RuntimeError(f"Stream {name!r} is not defined")
-        if self._image is None:
-            raise RuntimeError("request already released")
-        return self._image.copy()
+        if self._buffers is None:
+            raise RuntimeError("failed to find buffer")  # released: the camera owns it again
+        buf = self._buffers[name]
+        if name == "main":
+            return buf[:, : self.config["main"]["size"][0]]  # slices off stride padding, no copy
+        return buf  # YUV420: (H·3/2, stride), padding left in, as picamera2 does
+
+    def make_array(self, name: str) -> np.ndarray:
+        """A copy; main keeps ``WORLD.padded_width_px`` junk columns, as old picamera2 did."""
+        self._shared(name)  # the same checks
+        return self._buffers[name].copy()
 
     def get_metadata(self) -> Dict[str, Any]:
         return dict(self._metadata)
+
+
+class MappedArray:
+    """``with MappedArray(request, "lores") as m: m.array`` – the buffer in place, valid inside the block."""
+
+    def __init__(self, request: CompletedRequest, stream: str, reshape: bool = True, write: bool = True) -> None:
+        self._request = request
+        self._stream = stream
+        self._array: Optional[np.ndarray] = None
+
+    def __enter__(self) -> MappedArray:
+        self._array = self._request._shared(self._stream)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self._array = None
+
+    @property
+    def array(self) -> Optional[np.ndarray]:
+        return self._array
 
 
 class _Job:
@@ -205,6 +253,13 @@ class Picamera2:
             stream[key] = value
         w, h = stream["size"]
         stream["size"] = (w - w % 2, h - h % 2)  # align_stream(optimal=False)
+        if lores is not None:
+            lores = {"format": "YUV420", "size": stream["size"], "preserve_ar": False, **lores}
+            lw, lh = lores["size"]
+            lores["size"] = (lw - lw % 2, lh - lh % 2)
+        if colour_space is None:  # picamera2 picks by resolution
+            small = stream["size"][0] < 1280 or stream["size"][1] < 720
+            colour_space = libcamera.ColorSpace.Smpte170m() if small else libcamera.ColorSpace.Rec709()
         merged = {"NoiseReductionMode": 1, "FrameDurationLimits": (33333, 33333)}
         merged.update(controls or {})
         return {"use_case": use_case, "transform": transform or libcamera.Transform(),
@@ -231,6 +286,14 @@ class Picamera2:
         config["controls"] = controls
         main["stride"] = main["size"][0] * _BYTES_PER_PIXEL[main["format"]]
         config["main"] = main
+        if config.get("lores") is not None:
+            lores = dict(config["lores"])
+            if lores["format"] not in ("YUV420", "YVU420"):
+                raise RuntimeError("lores stream must be YUV")
+            if lores["size"][0] > main["size"][0] or lores["size"][1] > main["size"][1]:
+                raise RuntimeError("lores stream dimensions may not exceed main stream")
+            lores["stride"] = -(-lores["size"][0] // 64) * 64  # the ISP's row alignment
+            config["lores"] = lores
         self.camera_config = config
         self._applied = dict(controls)
         self._pending = []
@@ -358,7 +421,25 @@ class Picamera2:
             "FrameDuration": period_ns // 1000,
             **exposure,
         }
-        return CompletedRequest(self, np.ascontiguousarray(image), metadata)
+        return CompletedRequest(self, np.ascontiguousarray(image), metadata, self._lores(rgb))
+
+    def _lores(self, rgb: np.ndarray) -> Optional[np.ndarray]:
+        """The lores stream's I420 buffer for this frame's RGB content (None without a lores stream)."""
+        lores = self.camera_config.get("lores")
+        if lores is None:
+            return None
+        (w, h), stride = lores["size"], lores["stride"]
+        bgr = np.ascontiguousarray(rgb[:, :, ::-1])
+        if bgr.shape[:2] != (h, w):
+            bgr = cv2.resize(bgr, (w, h), interpolation=cv2.INTER_AREA)
+        flat = cv2.cvtColor(bgr, cv2.COLOR_BGR2YUV_I420).reshape(-1)
+        n = (w // 2) * (h // 2)
+        buf = np.full((h * 3 // 2, stride), 77, np.uint8)
+        buf[:h, :w] = flat[: w * h].reshape(h, w)
+        chroma = buf[h:].reshape(2, h // 2, stride // 2)
+        chroma[0, :, : w // 2] = flat[w * h: w * h + n].reshape(h // 2, w // 2)
+        chroma[1, :, : w // 2] = flat[w * h + n:].reshape(h // 2, w // 2)
+        return buf
 
 
 def _to_format(rgb: np.ndarray, fmt: str) -> np.ndarray:

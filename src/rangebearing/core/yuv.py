@@ -1,0 +1,192 @@
+"""Band search on a camera's YUV420 stream: red and blue masks straight from the chroma planes.
+
+The Pi's ISP can hand over a second stream (``lores``, YUV420) beside the BGR
+frame at no CPU cost. Its U and V planes are already at half resolution,
+which is the fast path's downscale step, so the search needs neither the
+BGR average nor the BGR→HSV conversion: each pixel's class comes from one
+table lookup on its (U, V) pair and a comparison of its Y with two bounds
+from the same table. The result is the mask pair
+:func:`rangebearing.core.detect.region_masks` makes from a BGR frame; the
+landmarks are then measured on the BGR frame as before.
+
+Why a table on (U, V) is exact: RGB = a·(Y − y0) + d(U, V), the same ``a·(Y − y0)``
+added to every channel, so the channel differences (hence HSV hue) depend on
+U and V alone, as does the chroma C = max − min. Saturation C / max and value
+max = a·(Y − y0) + max(d) turn into bounds on Y: ``V ≥ v_min`` is
+``Y ≥ ylo(U, V)`` and ``S ≥ s_min`` is ``Y ≤ yhi(U, V)``. Only channel
+clipping at 0 and 255 is not modelled. Grey-world gains (a diagonal gain on
+R, G, B) are an affine map of (Y, U, V), applied to the planes before the
+lookup when they are not within 2 % of one.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Tuple
+
+import cv2
+import numpy as np
+
+from .._compat import frozen
+from .color import UNIT_GAINS, Gains
+from .denoise import majority_filter
+from .params import DetectionParams
+
+# Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
+# B = a·(Y − y0) + bu·(U − 128). SMPTE 170M is BT.601 limited range: libcamera's default for
+# video below 1280×720, and what OpenCV's COLOR_BGR2YUV_I420 produces.
+COLOUR_SPACES = {
+    "smpte170m": (255 / 219, 16.0, 255 / 224 * 1.402, -255 / 224 * 1.772 * 0.114 / 0.587,
+                  -255 / 224 * 1.402 * 0.299 / 0.587, 255 / 224 * 1.772),
+    "sycc": (1.0, 0.0, 1.402, -1.772 * 0.114 / 0.587, -1.402 * 0.299 / 0.587, 1.772),
+    "rec709": (255 / 219, 16.0, 255 / 224 * 1.5748, -255 / 224 * 1.8556 * 0.0722 / 0.7152,
+               -255 / 224 * 1.5748 * 0.2126 / 0.7152, 255 / 224 * 1.8556),
+}
+NONE, RED, BLUE = 0, 1, 2
+
+
+@frozen
+class Yuv420:
+    """A YUV420 (I420) image as three uint8 planes, views into the camera's buffer where it has one.
+
+    ``y`` is (H, W); ``u`` and ``v`` are (H/2, W/2), one chroma sample per 2×2
+    block of Y. ``colour_space`` names the Y'CbCr matrix (:data:`COLOUR_SPACES`).
+    """
+
+    y: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    colour_space: str = "smpte170m"
+
+
+def yuv420_from_bgr(bgr: np.ndarray) -> Yuv420:
+    """What a camera's YUV420 stream would hold for a BGR frame (OpenCV's I420, SMPTE 170M).
+
+    For recorded and synthetic sources and for tests; width and height must be even.
+    """
+    h, w = bgr.shape[:2]
+    if h % 2 or w % 2:
+        raise ValueError(f"YUV420 needs an even width and height, not {w}×{h}")
+    return yuv420_planes(cv2.cvtColor(bgr, cv2.COLOR_BGR2YUV_I420), w, h)
+
+
+def yuv420_planes(buffer: np.ndarray, width_px: int, height_px: int, colour_space: str = "smpte170m") -> Yuv420:
+    """Views of the Y, U and V planes of a YUV420 buffer laid out as Picamera2 maps it; nothing is copied.
+
+    Parameters
+    ----------
+    buffer : (H * 3 / 2, stride) uint8 array
+        Y (H rows of ``stride`` bytes), then U and V (H/2 rows of ``stride/2``
+        bytes each). ``stride`` ≥ W; bytes past W (past W/2 in the chroma
+        planes) are padding.
+    width_px, height_px : int
+        The image size (even).
+    """
+    w, h = int(width_px), int(height_px)
+    if buffer.ndim != 2 or buffer.dtype != np.uint8 or buffer.shape[0] != h * 3 // 2 or buffer.shape[1] < w:
+        raise ValueError(f"not a {w}×{h} YUV420 buffer: {buffer.dtype} {buffer.shape}")
+    stride = buffer.shape[1]
+    y = buffer[:h, :w]
+    chroma = buffer[h:].reshape(-1)
+    if not chroma.flags.c_contiguous:  # a strided view of a larger array: rows cannot be regrouped in place
+        chroma = np.ascontiguousarray(chroma)
+    planes = chroma.reshape(2, h // 2, stride // 2)
+    return Yuv420(y, planes[0, :, : w // 2], planes[1, :, : w // 2], colour_space)
+
+
+def _rgb_matrix(colour_space: str) -> Tuple[np.ndarray, np.ndarray]:
+    """(3×3 M, 3 offset) with [R, G, B] = M · [Y, U, V] + offset."""
+    a, y0, rv, gu, gv, bu = COLOUR_SPACES[colour_space]
+    m = np.array([[a, 0.0, rv], [a, gu, gv], [a, bu, 0.0]])
+    return m, -m @ np.array([y0, 128.0, 128.0])
+
+
+def yuv_grey_world_gains(yuv: Yuv420, limit: float = 2.0) -> Gains:
+    """:func:`~rangebearing.core.color.grey_world_gains` from the planes' means (means commute with the matrix)."""
+    a, y0, rv, gu, gv, bu = COLOUR_SPACES[yuv.colour_space]
+    yl = a * (cv2.mean(yuv.y)[0] - y0)
+    du, dv = cv2.mean(yuv.u)[0] - 128.0, cv2.mean(yuv.v)[0] - 128.0
+    b, g, r = yl + bu * du, yl + gu * du + gv * dv, yl + rv * dv
+    grey = (b + g + r) / 3.0
+    if grey <= 1.0:
+        return UNIT_GAINS
+    return tuple(min(limit, max(1.0 / limit, grey / max(c, 1e-3))) for c in (b, g, r))  # type: ignore[return-value]
+
+
+@functools.lru_cache(maxsize=8)
+def class_table(colour_space: str, red_hue: tuple, blue_hue: tuple, s_min: int, v_min: int) -> np.ndarray:
+    """(65536,) uint32 table indexed by ``U << 8 | V``: ylo | yhi << 8 | class << 16.
+
+    A pixel is of ``class`` (RED, BLUE; NONE is 0) when ``ylo ≤ Y ≤ yhi``;
+    hue follows OpenCV's 8-bit convention (0–179), S and V are 0–255 and
+    rounded as OpenCV rounds them.
+    """
+    a, y0 = COLOUR_SPACES[colour_space][:2]
+    m, _ = _rgb_matrix(colour_space)
+    u, v = np.meshgrid(np.arange(256.0), np.arange(256.0), indexing="ij")
+    d = np.stack([m[k, 1] * (u - 128.0) + m[k, 2] * (v - 128.0) for k in range(3)], axis=-1)  # R, G, B minus a(Y-y0)
+    bgr = np.ascontiguousarray(d[..., ::-1] + 256.0, dtype=np.float32)  # hue does not change with a common offset
+    hue = cv2.cvtColor(bgr.reshape(-1, 1, 3), cv2.COLOR_BGR2HSV)[:, 0, 0].reshape(256, 256)
+    hue8 = np.round(hue / 2.0).astype(np.int64) % 180
+    chroma = d.max(axis=-1) - d.min(axis=-1)
+    top = d.max(axis=-1)
+    cls = np.zeros((256, 256), np.uint32)
+    for label, ranges in ((RED, red_hue), (BLUE, blue_hue)):
+        inside = np.zeros((256, 256), bool)
+        for lo, hi in ranges:
+            inside |= (hue8 >= lo) & (hue8 <= hi)
+        cls[inside & (chroma > 0)] = label
+    # V = a(Y - y0) + top ≥ v_min - 0.5 ; S = 255·C / V ≥ s_min - 0.5  (8-bit rounding)
+    ylo = np.ceil(y0 + (v_min - 0.5 - top) / a)
+    with np.errstate(divide="ignore"):
+        vmax = 255.0 * chroma / max(s_min - 0.5, 1e-6)
+    yhi = np.floor(y0 + (vmax - top) / a)
+    empty = (ylo > yhi) | (ylo > 255) | (yhi < 0) | (cls == NONE)
+    ylo = np.where(empty, 255, np.clip(ylo, 0, 255)).astype(np.uint32)  # 255 ≤ Y ≤ 0: no pixel
+    yhi = np.where(empty, 0, np.clip(yhi, 0, 255)).astype(np.uint32)
+    return (ylo | (yhi << 8) | (cls << 16)).reshape(-1)
+
+
+def _balance(y: np.ndarray, u: np.ndarray, v: np.ndarray, gains: Gains, colour_space: str):
+    """Planes of the balanced image: the gains on R, G, B as one affine map of (Y, U, V)."""
+    m, off = _rgb_matrix(colour_space)
+    g = np.diag(np.asarray(gains, np.float64)[::-1])  # gains are (b, g, r); rows of m are R, G, B
+    inv = np.linalg.inv(m)
+    a = inv @ g @ m
+    b = inv @ (g @ off - off)
+    out = cv2.transform(cv2.merge((y, u, v)), np.hstack([a, b[:, None]]))
+    return cv2.split(out)
+
+
+def half_luma(y: np.ndarray) -> np.ndarray:
+    """Y averaged over each 2×2 block: the luma that goes with one chroma sample."""
+    h, w = y.shape
+    return cv2.resize(y[: h // 2 * 2, : w // 2 * 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+
+
+def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS) -> Tuple[np.ndarray, np.ndarray]:
+    """Red and blue masks (0/255 uint8, half resolution) of a YUV420 image, before the majority filter.
+
+    The same masks :func:`~rangebearing.core.color.class_masks` makes from the
+    balanced, downscaled BGR frame, up to rounding and channel clipping.
+    """
+    y, u, v = half_luma(yuv.y), yuv.u, yuv.v
+    if not all(abs(g - 1.0) <= 0.02 for g in gains):
+        y, u, v = _balance(y, np.ascontiguousarray(u), np.ascontiguousarray(v), gains, yuv.colour_space)
+    table = class_table(yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)),
+                        int(cfg.s_min), int(cfg.v_min))
+    idx = u.astype(np.uint16)
+    idx <<= 8
+    idx |= v
+    packed = table.take(idx).view(np.uint8).reshape(*idx.shape, 4)
+    ylo, yhi, cls, _ = cv2.split(packed)
+    ok = cv2.bitwise_and(cv2.compare(y, ylo, cv2.CMP_GE), cv2.compare(y, yhi, cv2.CMP_LE))
+    red = cv2.bitwise_and(cv2.compare(cls, RED, cv2.CMP_EQ), ok)
+    blue = cv2.bitwise_and(cv2.compare(cls, BLUE, cv2.CMP_EQ), ok)
+    return red, blue
+
+
+def yuv_region_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
+    """:func:`chroma_masks` after the band-preserving majority filter: what the box search takes."""
+    red, blue = chroma_masks(yuv, cfg, gains)
+    return majority_filter(red, ksize), majority_filter(blue, ksize)

@@ -1,0 +1,126 @@
+import cv2
+import numpy as np
+import pytest
+
+from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
+from rangebearing.core.detect import downscale
+from rangebearing.core.params import DetectionParams
+from rangebearing.core.yuv import (
+    BLUE,
+    NONE,
+    RED,
+    chroma_masks,
+    class_table,
+    yuv420_from_bgr,
+    yuv420_planes,
+    yuv_grey_world_gains,
+)
+from rangebearing.synth import LandmarkPose, Lighting, Scene, render
+
+DET = DetectionParams()
+
+
+def patch(bgr, size=4):
+    return np.full((size, size, 3), bgr, np.uint8)
+
+
+def bgr_masks(bgr, gains=None):
+    """The BGR fast path's unfiltered masks, for comparison."""
+    small = downscale(bgr, 2)
+    gains = grey_world_gains(small) if gains is None else gains
+    return class_masks(to_hsv(apply_gains(small, gains)), DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min)
+
+
+def test_opencv_i420_is_smpte170m_limited_range():
+    # pure red, white and black as the camera (and OpenCV's I420) encode them
+    for bgr, yuv in (((0, 0, 255), (82, 90, 240)), ((255, 255, 255), (235, 128, 128)), ((0, 0, 0), (16, 128, 128))):
+        planes = yuv420_from_bgr(patch(bgr))
+        assert (int(planes.y[0, 0]), int(planes.u[0, 0]), int(planes.v[0, 0])) == yuv
+
+
+@pytest.mark.parametrize("pad", [0, 32])
+def test_planes_are_views_that_skip_the_stride_padding(pad):
+    rng = np.random.default_rng(0)
+    w, h = 8, 6
+    y = rng.integers(0, 256, (h, w), np.uint8)
+    u = rng.integers(0, 256, (h // 2, w // 2), np.uint8)
+    v = rng.integers(0, 256, (h // 2, w // 2), np.uint8)
+    stride = w + pad
+    buf = np.full((h * 3 // 2, stride), 77, np.uint8)  # 77: padding that must never be read
+    buf[:h, :w] = y
+    chroma = buf[h:].reshape(2, h // 2, stride // 2)
+    chroma[0, :, : w // 2], chroma[1, :, : w // 2] = u, v
+    planes = yuv420_planes(buf, w, h)
+    assert np.array_equal(planes.y, y) and np.array_equal(planes.u, u) and np.array_equal(planes.v, v)
+    assert np.shares_memory(planes.y, buf) and np.shares_memory(planes.v, buf)
+
+
+def test_a_buffer_of_the_wrong_shape_is_refused():
+    with pytest.raises(ValueError, match="YUV420"):
+        yuv420_planes(np.zeros((10, 8), np.uint8), 8, 6)  # 6 rows of Y need 9 rows in all
+    with pytest.raises(ValueError, match="even"):
+        yuv420_from_bgr(np.zeros((5, 8, 3), np.uint8))
+
+
+@pytest.mark.parametrize(
+    "bgr, cls",
+    [
+        ((30, 30, 200), RED),
+        ((60, 20, 200), RED),  # hue wraps near 179
+        ((200, 40, 30), BLUE),
+        ((180, 180, 180), NONE),  # white
+        ((40, 160, 40), NONE),  # green
+        ((70, 110, 160), NONE),  # tan floor: too little saturation
+        ((5, 5, 20), NONE),  # too dark to trust
+    ],
+)
+def test_hand_picked_colours_classify_as_the_hsv_thresholds_do(bgr, cls):
+    planes = yuv420_from_bgr(patch(bgr))
+    red, blue = chroma_masks(planes, DET)
+    assert (red == 255).all() == (cls == RED) and (blue == 255).all() == (cls == BLUE)
+    hsv_red, hsv_blue = bgr_masks(patch(bgr), (1.0, 1.0, 1.0))
+    assert np.array_equal(red, hsv_red) and np.array_equal(blue, hsv_blue)
+
+
+def test_table_agrees_with_opencv_hsv_over_every_colour_of_a_grid():
+    # every (B, G, R) on a 16-level grid, encoded the way the camera does, one colour per 2×2 block
+    levels = np.arange(8, 256, 16, dtype=np.uint8)
+    grid = np.stack(np.meshgrid(levels, levels, levels, indexing="ij"), -1).reshape(-1, 1, 3)
+    bgr = np.repeat(np.repeat(grid.reshape(64, 64, 3), 2, 0), 2, 1)
+    small = bgr[::2, ::2]
+    planes = yuv420_from_bgr(bgr)
+    red, blue = chroma_masks(planes, DET)
+    # the reference: OpenCV's HSV of the colours themselves; 8-bit Y'CbCr rounding moves a few across a threshold
+    ref_red, ref_blue = class_masks(to_hsv(np.ascontiguousarray(small)), DET.red_hue, DET.blue_hue, DET.s_min,
+                                    DET.v_min)
+    assert small.shape[:2] == red.shape
+    for got, ref in ((red, ref_red), (blue, ref_blue)):
+        assert np.count_nonzero(ref) > 100
+        assert np.count_nonzero(got != ref) <= 0.05 * np.count_nonzero(ref)
+
+
+def test_table_is_cached_and_packs_bounds_and_class():
+    t = class_table("smpte170m", DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min)
+    assert t is class_table("smpte170m", DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min)
+    neutral = int(t[128 << 8 | 128])
+    assert neutral >> 16 == NONE and (neutral & 255) > ((neutral >> 8) & 255)  # an empty Y range
+    red = int(t[90 << 8 | 240])
+    assert red >> 16 == RED and (red & 255) <= 82 <= ((red >> 8) & 255)
+
+
+def _cast_scene():
+    warm = Lighting(colour=(1.25, 1.0, 0.8)) if "colour" in Lighting.__dataclass_fields__ else Lighting()
+    return Scene(landmarks=(LandmarkPose(0.5, 0.15), LandmarkPose(1.1, -0.2)), wall_distance_m=1.8, lighting=warm)
+
+
+def test_masks_and_gains_match_the_bgr_path_on_a_rendered_frame():
+    bgr = render(_cast_scene(), np.random.default_rng(3))
+    planes = yuv420_from_bgr(bgr)
+    gains = yuv_grey_world_gains(planes)
+    assert gains == pytest.approx(grey_world_gains(downscale(bgr, 2)), abs=0.01)
+    kernel = np.ones((3, 3), np.uint8)
+    for got, ref in zip(chroma_masks(planes, DET, gains), bgr_masks(bgr)):
+        n = np.count_nonzero(ref)
+        assert n > 100 and abs(np.count_nonzero(got) - n) <= 0.1 * n
+        edge = cv2.dilate(ref, kernel) != cv2.erode(ref, kernel)
+        assert not np.any((got != ref) & ~edge)  # they differ only on the bands' outlines
