@@ -1,10 +1,11 @@
 import dataclasses
+import math
 import re
 
 import numpy as np
 import pytest
 
-from rangebearing import FrameError, Pipeline, load_config
+from rangebearing import Config, FrameError, Pipeline, load_config
 from rangebearing.synth import LandmarkPose, Scene, render
 
 SCENE = Scene(landmarks=(LandmarkPose(0.4, 0.1),), wall_distance_m=2.0)
@@ -55,3 +56,24 @@ def test_the_paper_method_finds_one_landmark_with_its_own_model():
     (lm,) = Pipeline(paper.pipeline).process(render(SCENE)).landmarks
     assert lm.range_m == pytest.approx(0.4, rel=0.1)  # the paper's k = 35 px·m, uncalibrated
     assert lm.bearing_rad > 0
+
+
+@pytest.mark.parametrize("preset", ["multi", "clutter", "wide", "crowd", "touching"])
+def test_the_yuv_search_reads_what_the_bgr_search_reads(preset):
+    """Search on the chroma planes of OpenCV's I420, measure on BGR: the readings of the BGR path."""
+    from rangebearing.core.yuv import yuv420_from_bgr
+    from rangebearing.synth import random_scene
+
+    rng = np.random.default_rng(41)
+    params = Config().pipeline
+    compared = 0
+    for _ in range(4):
+        bgr = render(random_scene(rng, preset), rng)
+        want = Pipeline(params, track=False).process(bgr).landmarks
+        got = Pipeline(params, track=False).process(bgr, search=yuv420_from_bgr(bgr)).landmarks
+        assert len(got) == len(want)
+        for g, w in zip(got, want):
+            assert g.range_m == pytest.approx(w.range_m, rel=0.002)
+            assert abs(g.bearing_rad - w.bearing_rad) <= math.radians(0.02)
+            compared += 1
+    assert compared >= (1 if preset == "clutter" else 3)

@@ -36,6 +36,17 @@ def test_opencv_i420_is_smpte170m_limited_range():
     for bgr, yuv in (((0, 0, 255), (82, 90, 240)), ((255, 255, 255), (235, 128, 128)), ((0, 0, 0), (16, 128, 128))):
         planes = yuv420_from_bgr(patch(bgr))
         assert (int(planes.y[0, 0]), int(planes.u[0, 0]), int(planes.v[0, 0])) == yuv
+        i420 = cv2.cvtColor(patch(bgr), cv2.COLOR_BGR2YUV_I420).reshape(-1)
+        assert (i420[0], i420[16], i420[20]) == yuv
+
+
+def test_chroma_is_the_2x2_block_mean_where_opencv_point_samples():
+    block = np.zeros((2, 2, 3), np.uint8)
+    block[1, 1] = (0, 0, 255)  # one red pixel of four
+    planes = yuv420_from_bgr(block)
+    assert cv2.cvtColor(block, cv2.COLOR_BGR2YUV_I420).reshape(-1)[4:].tolist() == [128, 128]  # it sees none
+    mean = yuv420_from_bgr(np.full((2, 2, 3), (0, 0, 64), np.uint8))  # the block's mean colour
+    assert (int(planes.u[0, 0]), int(planes.v[0, 0])) == (int(mean.u[0, 0]), int(mean.v[0, 0]))
 
 
 @pytest.mark.parametrize("pad", [0, 32])

@@ -29,6 +29,7 @@ from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import reading_sigma
+from .yuv import Yuv420, yuv_find_candidates, yuv_grey_world_gains
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
 
@@ -94,12 +95,20 @@ class Pipeline:
             self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))
         return self._cams[key]
 
-    def process(self, frame: np.ndarray, t_s: Optional[float] = None) -> FrameResult:
+    def process(
+        self, frame: np.ndarray, t_s: Optional[float] = None, search: Optional[Yuv420] = None
+    ) -> FrameResult:
         """Find every landmark in a BGR uint8 frame; nearest first.
 
         ``t_s`` is the frame's capture time in seconds on any steady clock
         (the daemon passes the camera's timestamp); it sets the time step of
         the rate filters. Without it frames are taken to be 1/30 s apart.
+
+        ``search`` is the same view as a YUV420 image of the frame's size (the
+        camera's lores stream, :mod:`.yuv`): a full scan then looks for bands on
+        its chroma planes instead of downscaling and converting the frame, and
+        measures them on ``frame`` as always. Without it (or with another size,
+        or ``downscale`` other than 2) the frame is searched itself.
 
         Raises
         ------
@@ -123,10 +132,14 @@ class Pipeline:
                 found = [t.bands for t in self._tracks]
                 tracked = True
             else:
-                small = downscale(bgr, det.downscale)
+                yuv = search if search is not None and det.downscale == 2 and search.y.shape == (h, w) else None
+                small = downscale(bgr, det.downscale) if yuv is None else None
                 if det.white_balance == "grey_world":
-                    self._gains = grey_world_gains(small)
-                cands = find_candidates(small, det, self._gains, ksize, self.params.landmark)
+                    self._gains = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv)
+                if yuv is None:
+                    cands = find_candidates(small, det, self._gains, ksize, self.params.landmark)
+                else:
+                    cands = yuv_find_candidates(yuv, det, self._gains, ksize, self.params.landmark)
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 self._tracks = [Track(c) for c in found] if self.track else []

@@ -22,15 +22,17 @@ lookup when they are not within 2 % of one.
 from __future__ import annotations
 
 import functools
-from typing import Tuple
+from typing import List, Optional, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import UNIT_GAINS, Gains
+from .color import UNIT_GAINS, Gains, grey_world_gains, to_hsv
 from .denoise import majority_filter
 from .params import DetectionParams
+from .structure import Candidate, candidates
+from .types import LandmarkGeometry
 
 # Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
 # B = a·(Y − y0) + bu·(U − 128). SMPTE 170M is BT.601 limited range: libcamera's default for
@@ -43,6 +45,8 @@ COLOUR_SPACES = {
                -255 / 224 * 1.5748 * 0.2126 / 0.7152, 255 / 224 * 1.8556),
 }
 NONE, RED, BLUE = 0, 1, 2
+# B'G'R' → Cb, Cr (8 bit, limited range), rows U, V with a constant column: OpenCV's I420 coefficients
+_FORWARD = {"smpte170m": np.array([[0.439, -0.291, -0.148, 128.0], [-0.071, -0.368, 0.439, 128.0]])}
 
 
 @frozen
@@ -60,14 +64,25 @@ class Yuv420:
 
 
 def yuv420_from_bgr(bgr: np.ndarray) -> Yuv420:
-    """What a camera's YUV420 stream would hold for a BGR frame (OpenCV's I420, SMPTE 170M).
+    """What a camera's YUV420 stream would hold for a BGR frame (SMPTE 170M), for recorded and synthetic sources.
 
-    For recorded and synthetic sources and for tests; width and height must be even.
+    Y is OpenCV's ``COLOR_BGR2YUV_I420``. Its chroma is point-sampled (the
+    top-left pixel of each 2×2 block), where an ISP filters; here U and V are
+    the same matrix applied to the frame's 2×2 block means instead (means
+    commute with the matrix), the samples the search is meant to see. Width
+    and height must be even.
     """
     h, w = bgr.shape[:2]
     if h % 2 or w % 2:
         raise ValueError(f"YUV420 needs an even width and height, not {w}×{h}")
-    return yuv420_planes(cv2.cvtColor(bgr, cv2.COLOR_BGR2YUV_I420), w, h)
+    i420 = cv2.cvtColor(bgr, cv2.COLOR_BGR2YUV_I420)
+    small = cv2.resize(bgr, (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+    uv = cv2.transform(small, _FORWARD["smpte170m"])
+    chroma = i420[h:].reshape(-1)
+    n = (w // 2) * (h // 2)
+    chroma[:n] = uv[..., 0].reshape(-1)
+    chroma[n:] = uv[..., 1].reshape(-1)
+    return yuv420_planes(i420, w, h)
 
 
 def yuv420_planes(buffer: np.ndarray, width_px: int, height_px: int, colour_space: str = "smpte170m") -> Yuv420:
@@ -101,16 +116,27 @@ def _rgb_matrix(colour_space: str) -> Tuple[np.ndarray, np.ndarray]:
     return m, -m @ np.array([y0, 128.0, 128.0])
 
 
+def _bgr_affine(colour_space: str, gains: Gains = UNIT_GAINS) -> np.ndarray:
+    """3×4 matrix taking [Y, U, V, 1] to the balanced [B, G, R] (``gains`` are b, g, r)."""
+    m, off = _rgb_matrix(colour_space)
+    g = np.asarray(gains, np.float64)[::-1, None]  # rows of m are R, G, B
+    return np.hstack([g * m, g * off[:, None]])[::-1].copy()
+
+
+def yuv_to_bgr(y: np.ndarray, u: np.ndarray, v: np.ndarray, colour_space: str, gains: Gains = UNIT_GAINS
+               ) -> np.ndarray:
+    """BGR uint8 of three equal-sized planes, through the colour space's matrix and the gains (saturating)."""
+    yuv = cv2.merge((np.ascontiguousarray(y), np.ascontiguousarray(u), np.ascontiguousarray(v)))
+    return cv2.transform(yuv, _bgr_affine(colour_space, gains))
+
+
 def yuv_grey_world_gains(yuv: Yuv420, limit: float = 2.0) -> Gains:
-    """:func:`~rangebearing.core.color.grey_world_gains` from the planes' means (means commute with the matrix)."""
-    a, y0, rv, gu, gv, bu = COLOUR_SPACES[yuv.colour_space]
-    yl = a * (cv2.mean(yuv.y)[0] - y0)
-    du, dv = cv2.mean(yuv.u)[0] - 128.0, cv2.mean(yuv.v)[0] - 128.0
-    b, g, r = yl + bu * du, yl + gu * du + gv * dv, yl + rv * dv
-    grey = (b + g + r) / 3.0
-    if grey <= 1.0:
-        return UNIT_GAINS
-    return tuple(min(limit, max(1.0 / limit, grey / max(c, 1e-3))) for c in (b, g, r))  # type: ignore[return-value]
+    """:func:`~rangebearing.core.color.grey_world_gains` of the same ~40×30 thumbnail the BGR path balances on."""
+    h, w = yuv.y.shape
+    f = max(1, min(h // 30, w // 40))
+    size = (max(1, w // f), max(1, h // f))
+    y, u, v = (cv2.resize(p, size, interpolation=cv2.INTER_AREA) for p in (yuv.y, yuv.u, yuv.v))
+    return grey_world_gains(yuv_to_bgr(y, u, v, yuv.colour_space), limit)
 
 
 @functools.lru_cache(maxsize=8)
@@ -164,13 +190,15 @@ def half_luma(y: np.ndarray) -> np.ndarray:
     return cv2.resize(y[: h // 2 * 2, : w // 2 * 2], (w // 2, h // 2), interpolation=cv2.INTER_AREA)
 
 
-def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS) -> Tuple[np.ndarray, np.ndarray]:
+def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
+                 y_half: Optional[np.ndarray] = None) -> Tuple[np.ndarray, np.ndarray]:
     """Red and blue masks (0/255 uint8, half resolution) of a YUV420 image, before the majority filter.
 
     The same masks :func:`~rangebearing.core.color.class_masks` makes from the
     balanced, downscaled BGR frame, up to rounding and channel clipping.
+    ``y_half`` is :func:`half_luma` of ``yuv.y`` when the caller has it.
     """
-    y, u, v = half_luma(yuv.y), yuv.u, yuv.v
+    y, u, v = half_luma(yuv.y) if y_half is None else y_half, yuv.u, yuv.v
     if not all(abs(g - 1.0) <= 0.02 for g in gains):
         y, u, v = _balance(y, np.ascontiguousarray(u), np.ascontiguousarray(v), gains, yuv.colour_space)
     table = class_table(yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)),
@@ -186,7 +214,37 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS) -
     return red, blue
 
 
-def yuv_region_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
-    """:func:`chroma_masks` after the band-preserving majority filter: what the box search takes."""
-    red, blue = chroma_masks(yuv, cfg, gains)
-    return majority_filter(red, ksize), majority_filter(blue, ksize)
+class WindowHsv:
+    """The balanced half-resolution HSV image of a YUV420 frame, converted only where it is indexed.
+
+    ``hsv[rows, cols]`` (two slices) is what ``to_hsv(apply_gains(small, gains))[rows, cols]``
+    would be on the BGR path, up to rounding: the structure check reads a few
+    windows of it, so the frame is never converted whole.
+    """
+
+    def __init__(self, y_half: np.ndarray, yuv: Yuv420, gains: Gains) -> None:
+        self._planes = (y_half, yuv.u, yuv.v)
+        self._space = yuv.colour_space
+        self._gains = gains
+        self.shape = (*y_half.shape, 3)
+
+    def __getitem__(self, win: Tuple[slice, slice]) -> np.ndarray:
+        y, u, v = (p[win] for p in self._planes)
+        if y.size == 0:
+            return np.zeros((*y.shape, 3), np.uint8)
+        return to_hsv(yuv_to_bgr(y, u, v, self._space, self._gains))
+
+
+def yuv_find_candidates(
+    yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
+) -> List[Candidate]:
+    """:func:`~rangebearing.core.detect.find_candidates` with the band search on the YUV420 planes.
+
+    ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
+    full-resolution pixels of the frame the planes belong to.
+    """
+    y_half = half_luma(yuv.y)
+    red, blue = chroma_masks(yuv, cfg, gains, y_half)
+    red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
+    min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
+    return candidates(red, blue, WindowHsv(y_half, yuv, gains), 2, geometry, cfg.max_landmarks, min_area)

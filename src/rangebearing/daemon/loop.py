@@ -166,7 +166,7 @@ class Daemon:
                         log.info("end of stream")
                     return 0
                 t0 = clock()
-                result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9)
+                result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
                 t1 = clock()
                 pub = self.cfg.publish
                 payload = encode_fitting(pub.robot_id, seq, _unix_time(frame, t1), result.landmarks, self.stats.fps,

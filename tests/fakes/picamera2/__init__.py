@@ -22,9 +22,9 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
   Y (H rows), then U and V (H/2 rows of stride/2 bytes each), the stride
   rounded up to 64 bytes (the padding holds junk, 77). ``MappedArray(request,
   "lores")`` gives it as a (H·3/2, stride) array, as ``_make_array_shared``
-  does; the content is the main stream's scaled to the lores size, encoded as
-  OpenCV's ``COLOR_BGR2YUV_I420`` (SMPTE 170M, libcamera's default colour
-  space for video below 1280×720).
+  does; the content is the main stream's scaled to the lores size, encoded
+  as SMPTE 170M (libcamera's default colour space for video below 1280×720):
+  Y as OpenCV's ``COLOR_BGR2YUV_I420``, U and V from each 2×2 block's mean.
 * ``MappedArray(request, stream)`` maps the buffer in place (no copy, unlike
   ``make_array``); mapping a released request fails.
 
@@ -61,6 +61,7 @@ _KNOWN_CONTROLS = {
     "FrameDurationLimits", "NoiseReductionMode", "Brightness", "Contrast", "Saturation",
     "Sharpness", "ScalerCrop",
 }
+_CBCR = np.array([[0.439, -0.291, -0.148, 128.0], [-0.071, -0.368, 0.439, 128.0]])  # BGR → U, V (SMPTE 170M)
 _BYTES_PER_PIXEL = {"RGB888": 3, "BGR888": 3, "XBGR8888": 4, "XRGB8888": 4}
 
 
@@ -434,6 +435,9 @@ class Picamera2:
             bgr = cv2.resize(bgr, (w, h), interpolation=cv2.INTER_AREA)
         flat = cv2.cvtColor(bgr, cv2.COLOR_BGR2YUV_I420).reshape(-1)
         n = (w // 2) * (h // 2)
+        # the ISP filters chroma; OpenCV point-samples it: take it from the 2×2 block means instead
+        block = cv2.resize(bgr, (w // 2, h // 2), interpolation=cv2.INTER_AREA)
+        flat[w * h:] = cv2.transform(block, _CBCR).transpose(2, 0, 1).reshape(-1)
         buf = np.full((h * 3 // 2, stride), 77, np.uint8)
         buf[:h, :w] = flat[: w * h].reshape(h, w)
         chroma = buf[h:].reshape(2, h // 2, stride // 2)
