@@ -136,11 +136,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     _log(f"stage breakdown at {run.stage_label} …")
     try:
         for n, sc in stage_frames.items():
-            run.stages[n] = stage_breakdown(sc.cfg, sc.frames, repeats)
+            run.stages[n] = stage_breakdown(sc.cfg, sc.frames, repeats, sc.yuv)
     except (ImportError, AttributeError, TypeError, ValueError) as exc:  # the pipeline's internals moved
         run.stage_error = f"{type(exc).__name__}: {exc} (update benchmarks/bench_stages.py)"
         _log(f"stage breakdown failed: {run.stage_error}")
-    clip = build_scenario(base, *stage_res, 1, plan["daemon_frames"], 7, images)
+    clip = build_scenario(Config(), *stage_res, 1, plan["daemon_frames"], 7, images)  # the shipped defaults
     for fps, seconds in plan["daemon"]:
         _log(f"daemon at {fps:.0f} fps for {seconds:.0f} s …")
         run.daemon.append(daemon_run(clip.cfg, clip.frames, fps, seconds))

@@ -51,6 +51,13 @@ class ScenarioFrames:
     marker_scale: float
     scene_name: str = "clean"
     sequence: bool = True  # consecutive moments of a motion (a tracker may follow them)
+    yuv: List[object] = dataclasses.field(default_factory=list)  # each frame's YUV420 stream (as the ISP makes it)
+
+    def __post_init__(self) -> None:
+        if not self.yuv:
+            from rangebearing.core.yuv import yuv420_from_bgr
+
+            self.yuv = [yuv420_from_bgr(f) for f in self.frames]
 
     @property
     def label(self) -> str:

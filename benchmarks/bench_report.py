@@ -85,7 +85,7 @@ def _get(run: Run, key: Key, name: str, attr: str = "cold_ms") -> float:
 def per_frame_table(run: Run) -> str:
     rows = []
     for (res, scene), figs in run.figures.items():
-        for name in ("paper", "full", *MARKERS):
+        for name in ("paper", "full", "full yuv", *MARKERS):
             f = figs.get(name)
             if f is None:
                 continue
@@ -121,8 +121,10 @@ def ratio_table(run: Run) -> str:
         for name in ("paper", *MARKERS):
             cold, warm = ratio(_get(run, key, name), full), ratio(_get(run, key, name, "warm_ms"), full_w)
             cells.append(f"{times(cold)} ({times(warm)})")
-        rows.append([key[0], key[1], *cells])
-    return table(["resolution", "scene", *(f"{n} / full, cold (warm)" for n in ("paper", *MARKERS))], rows)
+        yuv = ratio(full, _get(run, key, "full yuv"))
+        rows.append([key[0], key[1], *cells, times(yuv)])
+    return table(["resolution", "scene", *(f"{n} / full, cold (warm)" for n in ("paper", *MARKERS)),
+                  "full / full yuv, cold"], rows)
 
 
 def scaling_table(run: Run) -> str:
@@ -144,8 +146,8 @@ def stage_table(run: Run) -> str:
     counts = sorted(run.stages)
     names = [name for name, _ in run.stages[counts[0]][0]]
     rows = [[name, *(ms(dict(run.stages[n][0]).get(name, math.nan)) for n in counts)] for name in names]
-    sums = [sum(t for name, t in run.stages[n][0] if not name.startswith("Pipeline")) for n in counts]
-    rows.append(["sum of the stages above", *(ms(s) for s in sums)])
+    sums = [sum(t for name, t in run.stages[n][0] if not name.startswith(("Pipeline", "yuv"))) for n in counts]
+    rows.append(["sum of the BGR stages above", *(ms(s) for s in sums)])
     rows.append(["landmarks found", *(str(run.stages[n][1]) for n in counts)])
     return table(["stage (median CPU ms, warm)", *(f"N={n}" for n in counts)], rows)
 

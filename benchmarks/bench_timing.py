@@ -72,7 +72,7 @@ class Figures:
 
 
 def rangebearing_contenders(sc: ScenarioFrames, markers: Dict[str, Process]) -> List[Contender]:
-    """paper, full, track, and the marker detectors given (name → detect), for one scenario."""
+    """paper, full, full yuv (searching the YUV420 stream), track and the marker detectors (name → detect)."""
     cfg: Config = sc.cfg
     paper = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, method="paper"))
 
@@ -83,6 +83,9 @@ def rangebearing_contenders(sc: ScenarioFrames, markers: Dict[str, Process]) -> 
         Contender("paper", Pipeline(paper.pipeline, track=False).process, n_truth),
         Contender("full", Pipeline(cfg.pipeline, track=False).process, n_truth),
     ]
+    full_yuv = Pipeline(cfg.pipeline, track=False)
+    by_frame = {id(f): y for f, y in zip(sc.frames, sc.yuv)}  # the camera hands both streams over together
+    out.append(Contender("full yuv", lambda frame: full_yuv.process(frame, by_frame[id(frame)]), n_truth))
     if sc.sequence:  # tracking needs consecutive frames
         out.append(Contender("track", Pipeline(cfg.pipeline, track=True).process, n_truth))
     for name, detect in markers.items():
