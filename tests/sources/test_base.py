@@ -154,11 +154,12 @@ class TestOpenSource:
 
 def test_open_source_paces_with_the_given_sleep(tmp_path: Path) -> None:
     slept: List[float] = []
-    cfg = SourceConfig(kind="recorded", path=str(_write_dir(tmp_path)), fps=1000.0)
+    # 20 ms a frame: a decode (and its YUV420 stream) on a loaded machine never overruns it
+    cfg = SourceConfig(kind="recorded", path=str(_write_dir(tmp_path)), fps=50.0)
     source = open_source(cfg, CameraIntrinsics(), sleep=lambda s: slept.append(s))
     try:
         for _ in range(3):
             assert source.read() is not None
     finally:
         source.close()
-    assert slept and all(0 < s <= 0.001 + 1e-9 for s in slept)
+    assert slept and all(0 < s <= 0.02 + 1e-9 for s in slept)

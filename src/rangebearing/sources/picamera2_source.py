@@ -39,9 +39,13 @@ from typing import Any, Callable, Dict, Optional
 import numpy as np
 
 from ..config import SourceConfig
-from ..core.yuv import Yuv420, yuv420_planes
+from ..core.yuv import Yuv420
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
+from .camera_buffers import Held, copied, lores_planes
+from .sensor_time import boot_offset_ns, frames_missed, sensor_to_monotonic_ns
+
+__all__ = ["Picamera2Source", "camera_controls", "frames_missed", "sensor_to_monotonic_ns"]
 from .faults import TimeoutBudget
 
 _log = logging.getLogger(__name__)
@@ -65,37 +69,6 @@ def camera_controls(cfg: SourceConfig) -> Dict[str, Any]:
         controls.pop("FrameDurationLimits", None)
     controls.update(user)
     return controls
-
-
-def sensor_to_monotonic_ns(sensor_ns: int, received_ns: int, boot_offset_ns: int) -> int:
-    """Put a ``SensorTimestamp`` on CLOCK_MONOTONIC.
-
-    libcamera's control_ids_core.yaml documents SensorTimestamp as CLOCK_BOOTTIME,
-    but the Pi pipeline copies the V4L2 buffer timestamp (CLOCK_MONOTONIC) and
-    picamera2 itself compares it with ``time.monotonic_ns()`` (``capture_request(
-    flush=...)`` in picamera2.py). The two clocks differ only by time spent in
-    suspend (``boot_offset_ns`` = BOOTTIME − MONOTONIC). A frame is always
-    exposed before it is received, so a stamp later than ``received_ns`` must be
-    BOOTTIME; if even the converted stamp is in the future, use ``received_ns``.
-    """
-    if sensor_ns <= received_ns:
-        return sensor_ns
-    converted = sensor_ns - boot_offset_ns
-    return converted if converted <= received_ns else received_ns
-
-
-def frames_missed(prev_ns: Optional[int], sensor_ns: int, period_ns: float) -> int:
-    """Frames lost between two sensor timestamps ``period_ns`` apart (0 for the first)."""
-    if prev_ns is None or period_ns <= 0:
-        return 0
-    return max(0, round((sensor_ns - prev_ns) / period_ns) - 1)
-
-
-def _boot_offset_ns() -> int:
-    boottime = getattr(time, "CLOCK_BOOTTIME", None)
-    if boottime is None:
-        return 0
-    return time.clock_gettime_ns(boottime) - time.monotonic_ns()
 
 
 def _import(name: str) -> Any:
@@ -138,7 +111,7 @@ class Picamera2Source:
         self._stop_timeout_s = stop_timeout_s
         self._cam: Any = None
         self._mapped: Any = None  # picamera2.MappedArray, or None (very old picamera2: make_array copies)
-        self._held: Any = None  # (request, [entered MappedArrays]) of the frame last returned
+        self._held: Optional[Held] = None  # the request of the frame last returned, with its mapped streams
         self._width = cfg.width_px
         self._lores_size: Optional[tuple] = None
         self._boot_offset_ns = 0
@@ -198,7 +171,7 @@ class Picamera2Source:
             msg = f"camera {cfg.camera_num}: cannot configure and start: {exc}"
             raise CameraError(msg) from exc
         self._cam = cam
-        self._boot_offset_ns = _boot_offset_ns()
+        self._boot_offset_ns = boot_offset_ns()
         self._prev_sensor_ns = None
         self._next_index = 0
         self._dropped = 0
@@ -246,11 +219,10 @@ class Picamera2Source:
         except (RuntimeError, concurrent.futures.CancelledError) as exc:
             raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc}") from exc
         received_ns = self._clock()
-        maps: list = []
-        self._held = (request, maps)
+        held = self._held = Held(request, self._mapped, self._cfg.camera_num)
         try:
-            array = self._array(request, "main", maps)
-            lores = self._array(request, "lores", maps) if self._lores_size else None
+            array = held.array("main")
+            lores = held.array("lores") if self._lores_size else None
             metadata = request.get_metadata()
         except (RuntimeError, ValueError) as exc:
             self._release_held()
@@ -260,47 +232,17 @@ class Picamera2Source:
         if isinstance(array, np.ndarray) and array.ndim == 3:
             array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
         image = validate_frame(array)  # a view when the buffer is contiguous, else one copy
-        search = self._planes(lores)
+        search = lores_planes(lores, self._lores_size, self._cfg.camera_num)
         if not self._in_place:  # the caller may keep the frame: copy it out, give the buffers back now
-            image = image.copy() if not image.flags.owndata else image
-            if search is not None:
-                search = Yuv420(search.y.copy(), search.u.copy(), search.v.copy(), search.colour_space)
+            image = image if image.flags.owndata else image.copy()
+            search = copied(search)
             self._release_held()
         return self._stamp(image, search, metadata, received_ns)
 
-    def _array(self, request: Any, stream: str, maps: list) -> np.ndarray:
-        """The stream's buffer in place (MappedArray, kept mapped until release), or make_array's copy."""
-        if self._mapped is None:
-            return request.make_array(stream)
-        m = self._mapped(request, stream, write=False)
-        m.__enter__()
-        maps.append(m)
-        return m.array
-
-    def _planes(self, lores: Optional[np.ndarray]) -> Optional[Yuv420]:
-        if lores is None or self._lores_size is None:
-            return None
-        w, h = self._lores_size
-        try:
-            return yuv420_planes(lores, w, h, "smpte170m")
-        except ValueError as exc:  # an odd buffer: search the main image instead
-            _log.debug("camera %d: lores unusable: %s", self._cfg.camera_num, exc)
-            return None
-
     def _release_held(self) -> None:
         held, self._held = self._held, None
-        if held is None:
-            return
-        request, maps = held
-        for m in maps:
-            try:
-                m.__exit__(None, None, None)
-            except Exception as exc:  # keep releasing: the buffer must go back
-                _log.warning("camera %d: unmapping failed: %s", self._cfg.camera_num, exc)
-        try:
-            request.release()
-        except RuntimeError as exc:
-            _log.warning("camera %d: release failed: %s", self._cfg.camera_num, exc)
+        if held is not None:
+            held.release()
 
     def _timed_out(self, cam: Any) -> Exception:
         # The timed-out job is still queued: flush it before it swallows a frame.
