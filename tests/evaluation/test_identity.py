@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 from typing import List, Optional, Sequence, Tuple
 
+import pytest
+
 from rangebearing.core.types import Landmark
 from rangebearing.evaluation.identity import id_report, match_identities
 from rangebearing.evaluation.truth import TruthRow
@@ -71,3 +73,16 @@ def test_matching_uses_range_too_and_skips_hidden_robots():
     assert sorted((t.robot, f.track_id) for t, f in pairs) == [(0, 4), (1, 5)]
     assert match_identities([lm(0.5, 0.2, 1)], [tr(0, 0.5, 0.0)]) == []  # 11° apart: not this one
     assert match_identities([lm(0.7, 0.0, 1)], [tr(0, 0.5, 0.0)]) == []  # 40 % off in range
+
+
+def test_published_rates_are_compared_with_the_truths_motion():
+    # the robot closes in at 0.3 m/s (0.01 m per frame at 30 fps) and turns left at 0.6 rad/s;
+    # the detections say -0.25 m/s and 0.6 rad/s: off by 0.05 m/s and 0
+    frames = []
+    for k in range(10):
+        r, b = 1.0 - 0.01 * k, 0.02 * k
+        found = dataclasses.replace(lm(r, b, 1), range_rate_mps=-0.25, bearing_rate_radps=0.6)
+        frames.append(([found], [tr(0, r, b)]))
+    rep = id_report(frames)
+    assert rep.rates == 8  # the first and last frames have no central difference
+    assert rep.range_rate_err_mps[0] == pytest.approx(0.05) and rep.bearing_rate_err_radps[1] == pytest.approx(0.0)

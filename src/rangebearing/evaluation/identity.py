@@ -68,6 +68,9 @@ class IdReport:
     returns: int  # matched again after 1..max_gap frames unmatched
     returns_kept: int
     max_gap: int
+    rates: int = 0  # matched readings with published rates and a true rate to compare with
+    range_rate_err_mps: Tuple[float, float] = (math.nan, math.nan)  # |error|: median, p90
+    bearing_rate_err_radps: Tuple[float, float] = (math.nan, math.nan)
 
     @property
     def switches_per_1000(self) -> float:
@@ -79,18 +82,40 @@ class IdReport:
         return self.switches_per_1000 <= 1.0 and self.returns_kept == self.returns and self.untracked == 0
 
 
-def id_report(frames: Iterable[Tuple[Sequence[Landmark], Sequence[TruthRow]]], max_gap: int = 15) -> IdReport:
-    """Count id switches and returns over ``(detections, truths)`` per frame, in frame order."""
+def _rate_errors(published: List[Tuple[int, int, float, float]], where: Dict[Tuple[int, int], Tuple[float, float]],
+                 fps: float) -> Tuple[int, Tuple[float, float], Tuple[float, float]]:
+    """|published - true| rates, the true ones by central difference of the truth (frames 1/fps apart)."""
+    er, eb = [], []
+    for robot, index, rr, br in published:
+        a, b = where.get((robot, index - 1)), where.get((robot, index + 1))
+        if a is not None and b is not None:
+            er.append(abs(rr - (b[0] - a[0]) * fps / 2.0))
+            eb.append(abs(br - (b[1] - a[1]) * fps / 2.0))
+    if not er:
+        return 0, (math.nan, math.nan), (math.nan, math.nan)
+    return (len(er), (float(np.median(er)), float(np.percentile(er, 90))),
+            (float(np.median(eb)), float(np.percentile(eb, 90))))
+
+
+def id_report(frames: Iterable[Tuple[Sequence[Landmark], Sequence[TruthRow]]], max_gap: int = 15,
+              fps: float = 30.0) -> IdReport:
+    """Count id switches and returns over ``(detections, truths)`` per frame, in frame order (``fps``
+    apart: the true rates the published ones are compared with come from the truth's positions)."""
     last: Dict[int, Tuple[int, int]] = {}  # robot -> (track id, frame index) when last matched
+    where: Dict[Tuple[int, int], Tuple[float, float]] = {}  # (robot, frame index) -> true (range, bearing)
+    published: List[Tuple[int, int, float, float]] = []
     n_frames = pairs = switches = untracked = returns = kept = 0
     for index, (found, truths) in enumerate(frames):
         n_frames += 1
+        where.update(((int(t.robot), index), (t.range_m, t.bearing_rad)) for t in truths if t.robot is not None)
         for truth, lm in match_identities(found, truths):
             pairs += 1
             if lm.track_id < 0:
                 untracked += 1
                 continue
             robot = int(truth.robot)  # type: ignore[arg-type]
+            if lm.range_rate_mps is not None and lm.bearing_rate_radps is not None:
+                published.append((robot, index, lm.range_rate_mps, lm.bearing_rate_radps))
             if robot in last:
                 before, seen = last[robot]
                 gap = index - seen - 1
@@ -100,7 +125,8 @@ def id_report(frames: Iterable[Tuple[Sequence[Landmark], Sequence[TruthRow]]], m
                     returns += 1
                     kept += lm.track_id == before
             last[robot] = (lm.track_id, index)
-    return IdReport(n_frames, pairs, len(last), switches, untracked, returns, kept, max_gap)
+    return IdReport(n_frames, pairs, len(last), switches, untracked, returns, kept, max_gap,
+                    *_rate_errors(published, where, fps))
 
 
 def format_id_report(rep: IdReport) -> str:
@@ -111,5 +137,9 @@ def format_id_report(rep: IdReport) -> str:
         f"id switches       {rep.switches} ({rep.switches_per_1000:.2f} per 1,000 landmark-frames)",
         f"returns <= {rep.max_gap} fr   {rep.returns_kept} of {rep.returns} kept their id",
         *([f"untracked         {rep.untracked} matched landmarks without an id"] if rep.untracked else []),
+        *([f"range rate error  median {rep.range_rate_err_mps[0]:.3f} m/s  p90 {rep.range_rate_err_mps[1]:.3f} m/s"
+           f"  ({rep.rates} readings)",
+           f"bearing rate err  median {math.degrees(rep.bearing_rate_err_radps[0]):.2f}°/s"
+           f"  p90 {math.degrees(rep.bearing_rate_err_radps[1]):.2f}°/s"] if rep.rates else []),
         f"issue 8 ids       {verdict} the target (<= 1 switch per 1,000, every return keeps its id)",
     ])
