@@ -67,3 +67,21 @@ def test_thresholds_from_the_page_change_the_readings(static_clip: Path) -> None
         daemon.stop()
         t.join(10)
         hub.close()
+
+
+def test_thresholds_the_pipeline_refuses_leave_the_loop_running(static_clip: Path, monkeypatch) -> None:
+    from rangebearing.daemon import loop
+
+    cfg = clip_cfg(static_clip)
+    hub = ViewHub(Thresholds.of(cfg.detection))
+    pub = MemoryPublisher()
+    daemon = Daemon(cfg, opener, lambda c: pub, RecordingNotifier(), view=hub)
+
+    def refuse(*a, **k):
+        raise ValueError("no such pipeline")
+
+    monkeypatch.setattr(loop, "Pipeline", refuse)
+    hub.set_thresholds(dataclasses.replace(hub.thresholds, s_min=255))
+    assert daemon.run() == 0
+    assert len(pub.payloads) == 12 and all(len(decode_reading(p).landmarks) == 2 for p in pub.payloads)
+    assert hub.thresholds.s_min == 90 and daemon.cfg.detection.s_min == 90  # the page shows what runs

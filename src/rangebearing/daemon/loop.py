@@ -30,6 +30,7 @@ from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, Ra
 from ..net.fit import encode_fitting
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource
+from ..view.thresholds import Thresholds
 from .capture import CameraGone, CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
 from .stats import LoopStats, Summary
@@ -194,8 +195,14 @@ class Daemon:
         new = self.view.take_thresholds()  # type: ignore[union-attr]
         if new is None:
             return
-        self.cfg = dataclasses.replace(self.cfg, detection=new.apply(self.cfg.detection))
-        self._pipe = Pipeline(self.cfg.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
+        try:
+            cfg = dataclasses.replace(self.cfg, detection=new.apply(self.cfg.detection))
+            pipe = Pipeline(cfg.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
+        except (ValueError, TypeError) as exc:  # validated by the server already; a request never stops the loop
+            log.error("thresholds from the view page refused, keeping the running ones: %s", exc)
+            self.view.reset_thresholds(Thresholds.of(self.cfg.detection))  # type: ignore[union-attr]
+            return
+        self.cfg, self._pipe = cfg, pipe
         log.info("thresholds set from the view page: %s (not saved)", new.as_json())
 
     def _echo(self, payload: bytes) -> None:
@@ -254,8 +261,6 @@ class Daemon:
             src = new.source
             self.guard.timeout_s, self.guard.budget_s = src.timeout_s, src.timeout_s * src.retries
             if self.view is not None:
-                from ..view.thresholds import Thresholds
-
                 self.view.reset_thresholds(Thresholds.of(new.detection))
             log.info("config reloaded")
         finally:
