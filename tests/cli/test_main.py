@@ -65,9 +65,11 @@ def test_calibrate_plot(tmp_path, capsys, monkeypatch):
             return real_import(name, *a, **k)
 
         monkeypatch.setattr(builtins, "__import__", no_matplotlib)
-        assert main([*args, "--plot", str(tmp_path / "q.png")]) == 1
+        first = (tmp_path / "c.yaml").read_bytes()
+        assert main([*args, "--overwrite", "--plot", str(tmp_path / "q.png")]) == 1
         assert "--plot needs matplotlib" in capsys.readouterr().err
-    load_config(tmp_path / "c.yaml")  # the config was written before plotting
+        assert (tmp_path / "c.yaml").read_bytes() == first  # refused before the fit: nothing written
+    load_config(tmp_path / "c.yaml")
 
 
 def test_record_then_replay(tmp_path, static_clip, capsys):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 from pathlib import Path
@@ -24,6 +25,7 @@ from .common import (
     quiet_or_auto,
     save_config,
 )
+from .outputs import check_output_file
 
 STRICT_EXIT = 3  # the config is written, but the bearings say the intrinsics are wrong
 
@@ -42,6 +44,9 @@ def register(sub: Any) -> None:
     p.add_argument("--out", required=True, metavar="FILE", help="where to write the calibrated config (YAML)")
     add_config_arg(p)
     p.add_argument("--plot", metavar="FILE.png", help="plot measured against true range and the residuals")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an existing --out or --plot (the old --out is kept as FILE.bak); "
+                        "never the frames or the truth")
     p.add_argument("--strict", action="store_true",
                    help=f"exit {STRICT_EXIT} when the bearings say the intrinsics are wrong (the config is written)")
     p.add_argument("--fit-focal", action="store_true",
@@ -134,8 +139,22 @@ def fit_and_write(args: argparse.Namespace, cfg: Config, frames_dir: Path, truth
     return STRICT_EXIT if args.strict and check.suspect and not refitted else 0
 
 
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Fail now, not after the fit: --out and --plot writable, not inputs, matplotlib there for --plot."""
+    inputs = (args.path, args.truth, getattr(args, "plan", None), getattr(args, "record", None))
+    check_output_file(args.out, "--out", inputs, args.overwrite)
+    if args.plot:
+        check_output_file(args.plot, "--plot", (*inputs, args.out), args.overwrite)
+        logging.getLogger("matplotlib").setLevel(logging.ERROR)  # no font-cache chatter in the output
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise RangeBearingError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
+
+
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
+    _check_outputs(args)
     if args.guided:
         from .guided import run_guided_cmd  # only the guided session needs a live source
 

@@ -14,7 +14,7 @@ from typing import Any, Iterator
 import cv2
 
 from ..config import check
-from ..errors import FrameError, SourceError
+from ..errors import FrameError, OutputError
 from ..sources.factory import open_source
 from .common import (
     add_config_arg,
@@ -25,6 +25,7 @@ from .common import (
     quiet_or_auto,
     source_from_args,
 )
+from .outputs import check_output_dir, write_bytes_atomic
 
 
 def register(sub: Any) -> None:
@@ -39,6 +40,7 @@ def register(sub: Any) -> None:
     limit.add_argument("--frames", type=int, metavar="N", help="stop after N frames")
     limit.add_argument("--seconds", type=float, metavar="S", help="stop after S seconds")
     p.add_argument("--format", choices=("png", "jpg"), default="png", help="image format (default png, lossless)")
+    p.add_argument("--overwrite", action="store_true", help="write into a --out folder that is not empty")
     add_config_arg(p)
     add_source_args(p)
     add_quiet_arg(p)
@@ -49,15 +51,20 @@ def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     src_cfg = source_from_args(args, cfg.source) or cfg.source
     check(dataclasses.replace(cfg, source=src_cfg))
-    out = Path(args.out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise SourceError(f"cannot create {out}: {exc.strerror or exc}") from None
+    from_files = src_cfg.kind == "recorded"
+    if from_files:  # every file, in order, under its own name: frames still match their truth
+        src_cfg = dataclasses.replace(src_cfg, fps=0.0)
+    inputs = (src_cfg.path if from_files else None, getattr(args, "config", None))
+    out = check_output_dir(args.out, "--out", inputs, args.overwrite, create=False)
     stop = threading.Event()
     signal.signal(signal.SIGINT, lambda *_: stop.set())
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    source = open_source(src_cfg, cfg.camera, sleep=stop.wait)
+    source = open_source(src_cfg, cfg.camera, sleep=stop.wait)  # a source that fails leaves no --out behind
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        source.close()
+        raise OutputError(f"--out: cannot create {out}: {exc.strerror or exc}") from None
     n = bad = 0
     t_end = time.monotonic() + args.seconds if args.seconds else None
 
@@ -78,9 +85,11 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         for frame in progress(frames(), args.frames, "record", quiet_or_auto(args)):
-            path = out / f"{n:06d}.{args.format}"
-            if not cv2.imwrite(str(path), frame.image):
-                raise SourceError(f"cannot write {path}")
+            stem = Path(frame.name).stem if from_files and frame.name and not frame.name.isdigit() else f"{n:06d}"
+            ok, data = cv2.imencode(f".{args.format}", frame.image)
+            if not ok:
+                raise OutputError(f"cannot encode frame {n} as {args.format}")
+            write_bytes_atomic(out / f"{stem}.{args.format}", data.tobytes())
             n += 1
         dropped = source.dropped
     finally:

@@ -20,6 +20,7 @@ from ..evaluation.truth import read_truth
 from ..net.protocol import landmark_fields
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import add_config_arg, config_from_args, describe, progress
+from .outputs import AtomicText, check_output_dir, check_output_file, write_bytes_atomic
 
 
 def register(sub: Any) -> None:
@@ -37,6 +38,9 @@ def register(sub: Any) -> None:
     p.add_argument("--truth", metavar="FILE", help="CSV frame,range_m,bearing_rad: print an accuracy report")
     p.add_argument("--track", action="store_true", help="treat the frames as a sequence and track landmarks")
     p.add_argument("-q", "--quiet", action="store_true", help="do not print a line per frame")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an existing --out file and write into a non-empty --annotate folder "
+                        "(never over the frames, the truth or the config)")
     p.set_defaults(func=run)
 
 
@@ -46,18 +50,11 @@ def run(args: argparse.Namespace) -> int:
     pipe = Pipeline(cfg.pipeline, track=args.track)
     path = Path(args.path)
     is_video = path.is_file()
-    ann_dir = Path(args.annotate) if args.annotate else None
-    if ann_dir:
-        if ann_dir.exists() and not ann_dir.is_dir():
-            raise OutputError(f"--annotate: {ann_dir} exists and is not a folder")
-        try:
-            ann_dir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise OutputError(f"--annotate: cannot create {ann_dir}: {exc.strerror or exc}") from None
-    try:
-        out = open(args.out, "w", encoding="utf-8") if args.out else None  # noqa: SIM115
-    except OSError as exc:
-        raise OutputError(f"--out: cannot write {args.out}: {exc.strerror or exc}") from None
+    inputs = (args.path, args.truth, getattr(args, "config", None))
+    if args.out:  # checked before anything is written: never over an input, never over a file unasked
+        check_output_file(args.out, "--out", inputs, args.overwrite)
+    ann_dir = check_output_dir(args.annotate, "--annotate", inputs, args.overwrite) if args.annotate else None
+    out = AtomicText(args.out) if args.out else None
     evaluated: List[Tuple[str, Tuple[Landmark, ...], list]] = []
     bad = done = 0
     interrupted = False
@@ -86,8 +83,10 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{name}: " + (" | ".join(describe(lm) for lm in result.landmarks) or "-"), flush=True)
             if ann_dir:
                 stem = Path(name).stem if not is_video else f"{int(name):06d}"
-                if not cv2.imwrite(str(ann_dir / f"{stem}.png"), annotate(image, result)):
-                    raise OutputError(f"--annotate: cannot write {ann_dir / f'{stem}.png'}")
+                ok, png = cv2.imencode(".png", annotate(image, result))
+                if not ok:
+                    raise OutputError(f"--annotate: cannot encode {stem}.png")
+                write_bytes_atomic(ann_dir / f"{stem}.png", png.tobytes())
             if truth is not None:
                 evaluated.append((name, result.landmarks, truth.get(name, [])))
     except KeyboardInterrupt:
@@ -96,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"\nreplay: interrupted after {done} frames{what}", file=sys.stderr)
     finally:
         if out:
-            out.close()
+            out.close()  # renamed into place: the lines so far, also when interrupted
     if bad:
         print(f"{bad} frame(s) skipped as unreadable", file=sys.stderr)
     if truth is not None:
