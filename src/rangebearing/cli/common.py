@@ -142,11 +142,18 @@ def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[S
                 raise ConfigError([f"--source: {spec!r}: the camera number must be an integer"], "command line")
             src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest else src.camera_num)
         elif kind == "opencv":
-            src = dataclasses.replace(src, kind="opencv", device=rest or src.device)
+            if not rest:  # "opencv:" meaning device 0 silently surprised people: say which one
+                raise ConfigError([f"--source: {spec!r}: name the device, e.g. opencv:0 or opencv:/dev/video0"],
+                                  "command line")
+            src = dataclasses.replace(src, kind="opencv", device=rest)
         elif kind == "synthetic":
             src = dataclasses.replace(src, kind="synthetic")
         else:
-            src = dataclasses.replace(src, kind="recorded", path=rest if kind == "recorded" else spec)
+            path = rest if kind == "recorded" else spec
+            if path and not Path(path).exists():  # "--source webcam" is not a folder of frames
+                raise ConfigError([f"--source: {spec!r} is neither a source kind (picamera2[:N], opencv:DEVICE, "
+                                   "synthetic) nor an existing folder of images or video file"], "command line")
+            src = dataclasses.replace(src, kind="recorded", path=path)
     if fps is not None:
         if fps < 0:
             raise ConfigError(["--fps: must be >= 0"], "command line")

@@ -108,6 +108,7 @@ def describe_error(exc: BaseException) -> str:
 def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
     args_list = list(sys.argv[1:] if argv is None else argv)
+    os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")  # OpenCV's own [ WARN ] lines stay off stderr
     if chosen_command(args_list) == "run" and threading.current_thread() is threading.main_thread():
         _signals.install_early()  # before the heavy imports: a SIGHUP now must not end the daemon
     parser = build_parser(args_list)

@@ -68,6 +68,8 @@ def reloader(args: argparse.Namespace) -> Optional[Callable[[], Config]]:
 
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
+    if args.json and not (args.echo or cfg.daemon.echo):
+        raise ConfigError(["--json only applies with --echo (print the datagrams as sent)"], "command line")
     override = source_from_args(args, cfg.source)
     if override is not None:
         cfg = dataclasses.replace(cfg, source=override)
