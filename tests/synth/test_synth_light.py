@@ -114,3 +114,12 @@ def test_a_board_between_the_light_and_the_landmark_shadows_it():
     shaded = render_linear(Scene(landmarks=(lm,), lighting=light, boxes=(board,)))[body].mean()
     assert shaded == pytest.approx(light.ambient * 0.85, rel=0.01)  # ambient only: in full shadow
     assert open_sky > 1.8 * shaded
+
+
+def test_a_red_wall_tints_the_white_body_a_little():
+    lm, light = LandmarkPose(0.5, 0.0), Lighting(gloss=0.05)
+    body = (slice(235, 245), slice(300, 305))
+    grey = render_linear(Scene(landmarks=(lm,), lighting=light))[body].mean(axis=(0, 1))
+    red = render_linear(Scene(landmarks=(lm,), lighting=light, wall_colour=(0.7, 0.07, 0.06)))[body]
+    r, g, b = red.mean(axis=(0, 1))
+    assert r == pytest.approx(grey[0], rel=0.02) and 0.8 * grey[1] < g < 0.95 * grey[1] and b < 0.95 * grey[2]

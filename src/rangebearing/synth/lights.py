@@ -3,8 +3,9 @@
 :class:`Shader` keeps the original scalar form, ``albedo · (ambient + (1 −
 ambient)·max(0, n·l))``, for plain light (white, no spots, no gloss), so the
 original presets render bit for bit as before; :meth:`Shader.rich` handles
-coloured light, point lights with a cone, Blinn-Phong highlights and shadows
-cast onto landmarks (:mod:`.shadows`), and needs each hit's normal and position.
+coloured light, point lights with a cone, Blinn-Phong highlights, shadows
+cast onto landmarks (:mod:`.shadows`) and ambient light tinted by the room's
+floor and wall (:func:`bounce`), and needs each hit's normal and position.
 """
 
 from __future__ import annotations
@@ -17,6 +18,18 @@ import numpy as np
 from . import shadows
 from .scene import Scene
 from .shapes import Primitive
+
+NEUTRAL_FLOOR, NEUTRAL_WALL = 0.60, 0.78  # the default room: no tint
+
+
+def bounce(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Tints of the ambient light arriving from above and from below, from the room's
+    colours (one bounce, roughly): 1 for a neutral grey room; a red wall makes the light
+    from above reddish, a navy carpet the light from below dark blue."""
+    wall = np.asarray(scene.wall_colour if scene.wall_distance_m is not None else (NEUTRAL_WALL,) * 3)
+    up = 0.5 + 0.5 * np.minimum(wall / NEUTRAL_WALL, 1.3)  # half from a white ceiling
+    down = np.minimum(np.asarray(scene.floor_colour) / NEUTRAL_FLOOR, 1.3)
+    return up, 0.3 + 0.7 * down  # part of it comes off the walls and robots
 
 
 @dataclass(frozen=True)
@@ -36,6 +49,8 @@ class Shader:
     shininess: float = 60.0
     eye: Tuple[float, float, float] = (0.0, 0.1, 0.0)
     casters: shadows.Casters = field(default_factory=shadows.empty_casters)
+    bounce_up: np.ndarray = field(default_factory=lambda: np.ones(3))
+    bounce_down: np.ndarray = field(default_factory=lambda: np.ones(3))
 
     @classmethod
     def from_scene(cls, scene: Scene, prims: Optional[Sequence[Primitive]] = None,
@@ -54,9 +69,11 @@ class Shader:
         cone = np.array([(np.cos(np.radians(s.cone_deg)), np.cos(np.radians(s.cone_deg + s.soft_deg)))
                          for s in li.spots]).reshape(-1, 2)
         cast = shadows.casters(prims, landmarks, light, pos) if prims is not None else {}
+        up, down = bounce(scene)
         return cls(light, float(li.ambient), False, np.asarray(li.colour, float),
                    np.asarray(li.ambient_colour, float), pos, axis, power, cone,
-                   float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0), cast)
+                   float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0), cast,
+                   up, down)
 
     def __call__(self, albedo: np.ndarray, cos: np.ndarray) -> np.ndarray:
         """Plain Lambert: ``cos`` is n·l per hit; returns (..., 3) radiance."""
@@ -74,7 +91,9 @@ class Shader:
         direct = (1.0 - self.ambient) * np.maximum(cos, 0.0)
         if sun:
             direct = direct * shadows.lit(point, self.light, None, sun)
-        irr = self.ambient * self.ambient_colour + direct[:, None] * self.colour
+        w_up = 0.5 * (1.0 + normal[:, 1:2])
+        room = w_up * self.bounce_up + (1.0 - w_up) * self.bounce_down
+        irr = self.ambient * self.ambient_colour * room + direct[:, None] * self.colour
         spec = np.zeros(point.shape) if glossy and self.gloss > 0 else None
         view = None
         if spec is not None:
