@@ -90,7 +90,7 @@ def stage_breakdown(
                 laps.start()
                 y_half = half_luma(yuv.y)
                 laps.lap("yuv: half_luma (Y 2×2 mean)")
-                gains = yuv_grey_world_gains(yuv)
+                gains = yuv_grey_world_gains(yuv, y_half=y_half)
                 laps.lap("yuv: grey-world gains (thumbnail)")
                 red, blue = chroma_masks(yuv, det, gains, y_half)
                 laps.lap("yuv: chroma_masks (table on U, V; Y bounds)")

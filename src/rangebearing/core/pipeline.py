@@ -29,7 +29,7 @@ from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import reading_sigma
-from .yuv import Yuv420, yuv_find_candidates, yuv_grey_world_gains
+from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
 
@@ -134,12 +134,13 @@ class Pipeline:
             else:
                 yuv = search if search is not None and det.downscale == 2 and search.y.shape == (h, w) else None
                 small = downscale(bgr, det.downscale) if yuv is None else None
+                y_half = half_luma(yuv.y) if yuv is not None else None
                 if det.white_balance == "grey_world":
-                    self._gains = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv)
+                    self._gains = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
                 if yuv is None:
                     cands = find_candidates(small, det, self._gains, ksize, self.params.landmark)
                 else:
-                    cands = yuv_find_candidates(yuv, det, self._gains, ksize, self.params.landmark)
+                    cands = yuv_find_candidates(yuv, det, self._gains, ksize, self.params.landmark, y_half)
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 self._tracks = [Track(c) for c in found] if self.track else []

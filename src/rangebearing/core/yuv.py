@@ -130,12 +130,17 @@ def yuv_to_bgr(y: np.ndarray, u: np.ndarray, v: np.ndarray, colour_space: str, g
     return cv2.transform(yuv, _bgr_affine(colour_space, gains))
 
 
-def yuv_grey_world_gains(yuv: Yuv420, limit: float = 2.0) -> Gains:
-    """:func:`~rangebearing.core.color.grey_world_gains` of the same ~40×30 thumbnail the BGR path balances on."""
-    h, w = yuv.y.shape
+def yuv_grey_world_gains(yuv: Yuv420, limit: float = 2.0, y_half: Optional[np.ndarray] = None) -> Gains:
+    """:func:`~rangebearing.core.color.grey_world_gains` of the same ~40×30 thumbnail the BGR path balances on.
+
+    ``y_half`` is :func:`half_luma` of ``yuv.y`` when the caller has it (then
+    every plane is shrunk from half resolution).
+    """
+    y_half = half_luma(yuv.y) if y_half is None else y_half
+    h, w = y_half.shape
     f = max(1, min(h // 30, w // 40))
     size = (max(1, w // f), max(1, h // f))
-    y, u, v = (cv2.resize(p, size, interpolation=cv2.INTER_AREA) for p in (yuv.y, yuv.u, yuv.v))
+    y, u, v = (cv2.resize(p, size, interpolation=cv2.INTER_AREA) for p in (y_half, yuv.u, yuv.v))
     return grey_world_gains(yuv_to_bgr(y, u, v, yuv.colour_space), limit)
 
 
@@ -227,23 +232,29 @@ class WindowHsv:
         self._space = yuv.colour_space
         self._gains = gains
         self.shape = (*y_half.shape, 3)
+        self._last: Tuple[object, Optional[np.ndarray]] = (None, None)
 
     def __getitem__(self, win: Tuple[slice, slice]) -> np.ndarray:
+        key = tuple((s.start, s.stop, s.step) for s in win)
+        if self._last[0] == key:  # the structure check reads S and V of one window in a row
+            return self._last[1]  # type: ignore[return-value]
         y, u, v = (p[win] for p in self._planes)
-        if y.size == 0:
-            return np.zeros((*y.shape, 3), np.uint8)
-        return to_hsv(yuv_to_bgr(y, u, v, self._space, self._gains))
+        out = np.zeros((*y.shape, 3), np.uint8) if y.size == 0 else to_hsv(yuv_to_bgr(y, u, v, self._space,
+                                                                                      self._gains))
+        self._last = (key, out)
+        return out
 
 
 def yuv_find_candidates(
-    yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
+    yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
+    y_half: Optional[np.ndarray] = None,
 ) -> List[Candidate]:
     """:func:`~rangebearing.core.detect.find_candidates` with the band search on the YUV420 planes.
 
     ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
     full-resolution pixels of the frame the planes belong to.
     """
-    y_half = half_luma(yuv.y)
+    y_half = half_luma(yuv.y) if y_half is None else y_half
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
