@@ -10,7 +10,7 @@ robots cross) to :func:`hungarian`.
 
 from __future__ import annotations
 
-from typing import Optional, Tuple
+from typing import Tuple
 
 import numpy as np
 
@@ -83,25 +83,7 @@ def hungarian(cost: np.ndarray) -> np.ndarray:
     return out
 
 
-def _with_misses(cost: np.ndarray, inside: np.ndarray, unmatched: float) -> np.ndarray:
-    """Column per row (``-1``: unmatched) minimising pair costs plus ``unmatched`` per row or column left over.
-
-    The classic square augmentation: ``[[C, U], [U', 0]]`` with ``unmatched``
-    on the diagonals of ``U`` and ``U'`` and out-of-gate entries priced out.
-    """
-    k, m = cost.shape
-    big = 1.0 + 2.0 * (np.abs(np.where(inside, cost, 0.0)).sum() + unmatched * (k + m))
-    a = np.full((k + m, m + k), big)
-    a[:k, :m] = np.where(inside, cost, big)
-    a[np.arange(k), m + np.arange(k)] = unmatched
-    a[k + np.arange(m), np.arange(m)] = unmatched
-    a[k:, m:] = 0.0
-    picked = hungarian(a)[:k]
-    picked[picked >= m] = -1
-    return picked
-
-
-def assign_gated(cost: np.ndarray, gate: float, unmatched: Optional[float] = None) -> Tuple[np.ndarray, np.ndarray]:
+def assign_gated(cost: np.ndarray, gate: float) -> Tuple[np.ndarray, np.ndarray]:
     """Pairs (track, detection) with ``cost <= gate``: as many pairs as possible, then least total cost.
 
     Parameters
@@ -112,12 +94,6 @@ def assign_gated(cost: np.ndarray, gate: float, unmatched: Optional[float] = Non
         outside the gate.
     gate : float
         Pairs costing more are never made.
-    unmatched : float, optional
-        The price of leaving a row or a column unmatched. Given, the
-        assignment minimises the total of pair costs and these prices (a pair
-        is worth making only if it costs less than two of them, and two
-        mediocre pairs lose to one good pair when the third party is better
-        left alone). ``None``: as many pairs as possible, then least cost.
 
     Returns
     -------
@@ -140,8 +116,6 @@ def assign_gated(cost: np.ndarray, gate: float, unmatched: Optional[float] = Non
     per_row = inside.sum(axis=1)
     per_col = inside.sum(axis=0)
     sole = inside & (per_row == 1)[:, None] & (per_col == 1)[None, :]
-    if unmatched is not None:
-        sole &= cost < 2.0 * unmatched
     rows, cols = np.nonzero(sole)
     rest_r = np.nonzero(per_row - sole.sum(axis=1) > 0)[0]
     if rest_r.size == 0:
@@ -150,11 +124,8 @@ def assign_gated(cost: np.ndarray, gate: float, unmatched: Optional[float] = Non
     sub = cost[np.ix_(rest_r, rest_c)]
     sub_in = inside[np.ix_(rest_r, rest_c)]
     gated = np.where(sub_in, sub, 0.0)
-    if unmatched is not None:
-        picked = _with_misses(gated, sub_in, unmatched)
-    else:
-        big = 1.0 + 2.0 * np.abs(gated).sum()  # dearer than any set of gated pairs
-        picked = hungarian(np.where(sub_in, gated, big))
+    big = 1.0 + 2.0 * np.abs(gated).sum()  # dearer than any set of gated pairs
+    picked = hungarian(np.where(sub_in, gated, big))
     ok = picked >= 0
     ok[ok] = sub_in[np.nonzero(ok)[0], picked[ok]]
     r2, c2 = rest_r[ok], rest_c[picked[ok]]
