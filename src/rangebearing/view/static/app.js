@@ -227,8 +227,20 @@ async function start() {
     if (e.target.checked) img.src = "/stream.mjpg?layer=masks"; else img.removeAttribute("src");
   });
   const events = new EventSource("/api/events");
+  let wasDown = false;
   events.onmessage = (e) => update(JSON.parse(e.data));
-  events.onerror = () => { $("status").textContent = "disconnected, retrying…"; $("status").className = "status down"; };
+  events.onerror = () => {
+    wasDown = true;
+    $("status").textContent = "disconnected, retrying…"; $("status").className = "status down";
+  };
+  events.onopen = () => {  // the server came back (a restarted daemon): reopen the streams too
+    if (!wasDown) return;
+    wasDown = false;
+    for (const img of [$("stream"), $("masks")]) {
+      const src = img.getAttribute("src");
+      if (src) { img.removeAttribute("src"); setTimeout(() => { img.src = src; }, 0); }
+    }
+  };
 }
 
 start().catch((e) => say(`cannot start: ${e.message}`, false));
