@@ -214,3 +214,30 @@ def test_reloads_swap_the_publisher_and_survive_a_source_that_will_not_open(stat
     assert robots[:5] == ["alpha"] * 5 and robots[5:] == ["beta"] * 15
     assert "reload rejected: cannot open the new frame source" in caplog.text
     assert len(publishers) == 3 and all(p.closed for p in publishers)  # none leaked, the rejected one included
+
+
+def test_track_ids_hold_over_frames_and_are_not_reused_after_a_reload(static_clip, tmp_path):
+    cfg_file = tmp_path / "c.yaml"
+    base = f'source: {{kind: recorded, path: "{static_clip}", fps: 0, loop: true}}\n'
+    cfg_file.write_text(base)
+
+    from rangebearing.config import load_config
+
+    daemon = Daemon(load_config(cfg_file), opener, lambda c: MemoryPublisher(), RecordingNotifier(),
+                    reload=lambda: load_config(cfg_file))
+    ids: List[List[int]] = []
+
+    def echo(payload: bytes) -> None:
+        ids.append(sorted(lm.track_id for lm in decode_reading(payload).landmarks))
+        if len(ids) == 6:  # another pipeline (window tracking off): a new Pipeline, the id counter carried on
+            cfg_file.write_text(base + "detection: {tracking: false}\n")
+            daemon.request_reload()
+        elif len(ids) == 14:
+            daemon.stop()
+
+    daemon.echo = echo
+    assert daemon.run() == 0
+    n = len(STATIC_SCENE.landmarks)
+    first, last = ids[0], ids[-1]
+    assert first == list(range(n)) and all(frame == first for frame in ids[:6])  # a still scene keeps its ids
+    assert last == list(range(n, 2 * n)) and ids[-4:] == [last] * 4  # fresh ids after the reload, none reused
