@@ -14,12 +14,12 @@ from ..core.fit import Fit
 from ..core.focal_check import FocalCheck
 from ..errors import CalibrationError, RangeBearingError
 from ..evaluation.calibrate import calibrate_checked
-from ..evaluation.truth import read_truth
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import (
     add_config_arg,
     add_quiet_arg,
     add_source_args,
+    aligned_truth,
     config_from_args,
     progress,
     quiet_or_auto,
@@ -117,7 +117,7 @@ def report_focal(check: FocalCheck, refitted: bool, cfg: Config) -> None:
 
 
 def fit_and_write(args: argparse.Namespace, cfg: Config, frames_dir: Path, truth_path: Path, source_note: str) -> int:
-    truth = read_truth(truth_path)
+    truth = aligned_truth(frames_dir, truth_path)
 
     def frames() -> Any:
         items = ((name, image, truth.get(name, [])) for name, image in iter_recorded(frames_dir))

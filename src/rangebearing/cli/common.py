@@ -13,11 +13,14 @@ import shutil
 import sys
 import tempfile
 from pathlib import Path
-from typing import Iterable, Iterator, Optional, TypeVar, Union
+from typing import TYPE_CHECKING, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
 
 from ..config import Config, SourceConfig, dump_config, load_config
 from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
+
+if TYPE_CHECKING:
+    from ..evaluation.truth import TruthRow
 
 T = TypeVar("T")
 
@@ -202,3 +205,23 @@ def format_reading(reading: Reading) -> str:
     if reading.omitted:
         extras.append(f"{reading.omitted} more not sent: datagram full")
     return f"{line}  [{', '.join(extras)}]" if extras else line
+
+
+def aligned_truth(frames_path: Union[str, Path], truth_path: Union[str, Path]) -> Dict[str, List[TruthRow]]:
+    """The truth CSV keyed by the frames' own names (see :func:`~rangebearing.evaluation.truth.align_truth`).
+
+    A video's frames are named by their 0-based index, as ``replay`` prints them: ``0``, ``1``, …
+    """
+    from ..evaluation.truth import align_truth, read_truth
+    from ..sources.recorded import count_recorded, list_images
+
+    truth = read_truth(truth_path)
+    path = Path(frames_path)
+    if path.is_dir():
+        names = [p.name for p in list_images(path)]
+    else:
+        n = count_recorded(path)
+        if n is None:  # the container does not say: any index a truth row names may exist
+            n = 1 + max((int(k) for k in truth if k.strip().isdigit()), default=-1)
+        names = [str(i) for i in range(n)]
+    return align_truth(truth, names, str(truth_path))

@@ -16,10 +16,9 @@ from ..errors import FrameError, OutputError, SourceError
 from ..evaluation.annotate import annotate
 from ..evaluation.identity import format_id_report, id_report
 from ..evaluation.match import accuracy, format_report
-from ..evaluation.truth import read_truth
 from ..net.protocol import landmark_fields
 from ..sources.recorded import count_recorded, iter_recorded
-from .common import add_config_arg, config_from_args, describe, progress
+from .common import add_config_arg, aligned_truth, config_from_args, describe, progress
 from .outputs import AtomicText, check_output_dir, check_output_file, write_bytes_atomic
 
 
@@ -46,7 +45,7 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
-    truth = read_truth(args.truth) if args.truth else None
+    truth = aligned_truth(args.path, args.truth) if args.truth else None
     pipe = Pipeline(cfg.pipeline, track=args.track)
     path = Path(args.path)
     is_video = path.is_file()

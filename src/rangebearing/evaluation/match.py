@@ -12,6 +12,7 @@ from ..core.types import Landmark
 from .truth import TruthRow
 
 MATCH_GAP_RAD = math.radians(3.0)
+MATCH_RANGE_FRAC = 0.5  # a detection more than 50 % off the true range is another landmark
 
 
 @frozen
@@ -40,16 +41,19 @@ class Match:
 def match_frame(
     frame: str, found: Sequence[Landmark], truths: Sequence[TruthRow], gap_rad: float = MATCH_GAP_RAD
 ) -> Tuple[List[Match], List[Landmark]]:
-    """Match detections to truth by bearing, closest pairs first, each used once.
+    """Match detections to truth by bearing and range, closest pairs first, each used once.
 
-    Returns the matches (one per true landmark, ``found=None`` when missed)
+    A pair must be within ``gap_rad`` in bearing and within :data:`MATCH_RANGE_FRAC` of
+    the true range (two neighbours one behind the other share a bearing: range tells
+    them apart). Returns the matches (one per true landmark, ``found=None`` when missed)
     and the detections left over, which are false landmarks.
     """
     pairs = sorted(
-        (abs(f.bearing_rad - t.bearing_rad), i, j)
+        (abs(f.bearing_rad - t.bearing_rad) / gap_rad + abs(f.range_m - t.range_m) / (MATCH_RANGE_FRAC * t.range_m),
+         i, j)
         for i, f in enumerate(found)
         for j, t in enumerate(truths)
-        if abs(f.bearing_rad - t.bearing_rad) <= gap_rad
+        if abs(f.bearing_rad - t.bearing_rad) <= gap_rad and abs(f.range_m - t.range_m) <= MATCH_RANGE_FRAC * t.range_m
     )
     used_f, by_truth = set(), {}
     for _gap, i, j in pairs:

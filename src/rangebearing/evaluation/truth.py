@@ -17,7 +17,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from typing import Dict, Iterable, List, Optional, Union
+from typing import Dict, Iterable, List, Optional, Sequence, Union
 
 from .._compat import frozen
 from ..errors import TruthError
@@ -116,17 +116,20 @@ def _optional(rec: Dict[str, Optional[str]], where: str) -> Dict[str, object]:
 def read_truth(path: PathLike) -> Dict[str, List[TruthRow]]:
     """Read a truth CSV into ``{frame: [TruthRow, ...]}``, in file order.
 
+    A UTF-8 byte-order mark (Excel) is fine. Ranges must be > 0 and bearings within ±π.
+
     Raises
     ------
     TruthError
-        The file cannot be read, lacks a header column, or has a row with an
-        empty frame, a non-numeric or non-finite value, or a negative range;
-        the message gives the file, the line and the reason.
+        The file cannot be read or lacks a header column, or rows are bad (an
+        empty frame, a value that is not a finite number or out of range): the
+        message names every bad row (file, line, reason), not only the first.
     """
     name = os.fspath(path)
     out: Dict[str, List[TruthRow]] = {}
+    problems: List[str] = []
     try:
-        with open(path, newline="", encoding="utf-8") as f:
+        with open(path, newline="", encoding="utf-8-sig") as f:
             reader = csv.DictReader(f)
             header = reader.fieldnames
             if header is None:
@@ -138,19 +141,80 @@ def read_truth(path: PathLike) -> Dict[str, List[TruthRow]]:
             reader.fieldnames = [h.strip() for h in header]
             for rec in reader:
                 where = f"{name}:{reader.line_num}"
-                if any(rec.get(c) is None for c in COLUMNS):
-                    raise TruthError(f"{where}: too few fields")
-                frame = rec["frame"].strip()
-                if not frame:
-                    raise TruthError(f"{where}: empty frame")
-                range_m = _number(rec["range_m"], "range_m", where)
-                if range_m < 0:
-                    raise TruthError(f"{where}: range_m {range_m} is negative")
-                bearing = _number(rec["bearing_rad"], "bearing_rad", where)
-                extras = _optional(rec, where)
-                out.setdefault(frame, []).append(TruthRow(frame, range_m, bearing, **extras))  # type: ignore[arg-type]
+                try:
+                    row = _row(rec, where)
+                except TruthError as exc:
+                    problems.append(str(exc))
+                    continue
+                out.setdefault(row.frame, []).append(row)
     except OSError as exc:
         raise TruthError(f"{name}: cannot read: {exc.strerror or exc}") from None
     except (csv.Error, UnicodeDecodeError) as exc:
         raise TruthError(f"{name}: not a readable CSV file: {exc}") from None
+    if len(problems) == 1:
+        raise TruthError(problems[0])
+    if problems:
+        more = f"\n  ... and {len(problems) - 20} more" if len(problems) > 20 else ""
+        raise TruthError(f"{name}: {len(problems)} bad rows:\n  " + "\n  ".join(problems[:20]) + more)
+    return out
+
+
+def _row(rec: Dict[str, Optional[str]], where: str) -> TruthRow:
+    if any(rec.get(c) is None for c in COLUMNS):
+        raise TruthError(f"{where}: too few fields")
+    frame = (rec["frame"] or "").strip()
+    if not frame:
+        raise TruthError(f"{where}: empty frame")
+    range_m = _number(rec["range_m"], "range_m", where)  # type: ignore[arg-type]
+    if range_m <= 0:
+        raise TruthError(f"{where}: range_m {range_m} is {'negative' if range_m < 0 else 'zero'}: must be > 0")
+    bearing = _number(rec["bearing_rad"], "bearing_rad", where)  # type: ignore[arg-type]
+    if not -math.pi <= bearing <= math.pi:
+        raise TruthError(f"{where}: bearing_rad {bearing} is outside ±π (radians, not degrees?)")
+    return TruthRow(frame, range_m, bearing, **_optional(rec, where))  # type: ignore[arg-type]
+
+
+def _keys(name: str) -> List[str]:
+    """The names a frame may be given by: as written, file name, any case, without extension, as a number."""
+    base = name.replace("\\", "/").rsplit("/", 1)[-1]
+    low = base.lower()
+    stem = low.rsplit(".", 1)[0] if "." in low else low
+    keys = [name, base, low, stem]
+    if stem.isdigit():
+        keys.append(str(int(stem)))
+    return keys
+
+
+def align_truth(
+    truth: Dict[str, List[TruthRow]], frames: Sequence[str], source: str = "truth"
+) -> Dict[str, List[TruthRow]]:
+    """Truth keyed by the frames' own names, matched by file name, case, stem or number.
+
+    ``samples/clip/000000.jpg``, ``000000.JPG``, ``000000`` and (for a video, whose
+    frames are named by their 0-based index) ``0`` all name frame ``000000.jpg`` /
+    frame 0.
+
+    Raises
+    ------
+    TruthError
+        Truth rows name frames that are not there (every such name is listed, up to 10).
+    """
+    index: Dict[str, Optional[str]] = {}
+    for frame in frames:
+        for key in _keys(frame):
+            index[key] = frame if index.get(key, frame) == frame else None  # None: two frames share it
+    out: Dict[str, List[TruthRow]] = {}
+    unmatched: List[str] = []
+    for name, rows in truth.items():
+        frame = next((index[k] for k in _keys(name) if index.get(k)), None)
+        if frame is None:
+            unmatched.append(name)
+            continue
+        out.setdefault(frame, []).extend(rows)
+    if unmatched:
+        shown = ", ".join(repr(n) for n in unmatched[:10])
+        shown += f" and {len(unmatched) - 10} more" if len(unmatched) > 10 else ""
+        example = ", ".join(repr(f) for f in list(frames)[:3])
+        raise TruthError(f"{source}: {len(unmatched)} of {len(truth)} truth frame(s) match no frame: {shown} "
+                         f"(the frames are named like {example}; a video's frames by their 0-based index)")
     return out
