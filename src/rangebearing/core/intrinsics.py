@@ -9,7 +9,7 @@ wrong by percent while reporting a small reprojection error.
 from __future__ import annotations
 
 import math
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple, Union
 
 import cv2
 import numpy as np
@@ -76,15 +76,17 @@ def _tilt(corners: np.ndarray, obj: np.ndarray, size: Tuple[int, int]) -> Tuple[
     return tilt, math.degrees(math.atan2(n[1], n[0])) % 180.0
 
 
-def coverage_problems(views: Sequence[np.ndarray], obj: np.ndarray, size: Tuple[int, int]) -> List[str]:
+def coverage_problems(
+    views: Sequence[np.ndarray], obj: Union[np.ndarray, Sequence[np.ndarray]], size: Tuple[int, int]
+) -> List[str]:
     """Reasons the views cannot pin the intrinsics down; empty when they can.
 
     Parameters
     ----------
     views : sequence of (N, 2) arrays
         Corners found in each view.
-    obj : (N, 3) array
-        The board's corners (:func:`board_points`).
+    obj : (N, 3) array, or one (N_i, 3) array per view
+        The board's corners (:func:`board_points`), or each view's own (ChArUco views are partial).
     size : (width, height)
         Frame size in pixels.
     """
@@ -104,7 +106,8 @@ def coverage_problems(views: Sequence[np.ndarray], obj: np.ndarray, size: Tuple[
             f"(need {math.ceil(MIN_CELLS_FRAC * 16)}); show the board near the frame's edges and corners "
             f"(nothing in the {names} part)"
         )
-    tilts = [_tilt(v, obj, size) for v in views]
+    objs = [obj] * len(views) if isinstance(obj, np.ndarray) else list(obj)
+    tilts = [_tilt(v, o, size) for v, o in zip(views, objs)]
     tilted = [(t, az) for t, az in tilts if t >= MIN_TILT_DEG]
     axes = {int(az // 45) for _t, az in tilted}
     if len(tilted) < MIN_TILTED_VIEWS or len(axes) < 2:
@@ -142,17 +145,28 @@ def fit_intrinsics(
         The views fail :func:`coverage_problems` (every reason is given), or the fit diverges.
     """
     obj = board_points(cols, rows, square_m)
-    problems = coverage_problems(views, obj, size)
+    return fit_views(views, [obj] * len(views), size, k3)
+
+
+def fit_views(
+    views: Sequence[np.ndarray], objs: Sequence[np.ndarray], size: Tuple[int, int], k3: bool = False
+) -> IntrinsicsFit:
+    """:func:`fit_intrinsics` for views that each see their own subset of a planar target (ChArUco).
+
+    ``views[i]`` (N_i, 2) pixels are the images of ``objs[i]`` (N_i, 3) target points (z = 0).
+    """
+    problems = coverage_problems(views, objs, size)
     if problems:
         raise CalibrationError("poor coverage, no fit made:\n  - " + "\n  - ".join(problems))
     flags = 0 if k3 else cv2.CALIB_FIX_K3
     img = [np.asarray(v, np.float32).reshape(-1, 1, 2) for v in views]
-    rms, k, dist, rvecs, tvecs = cv2.calibrateCamera([obj] * len(img), img, size, None, None, flags=flags)
+    obj3 = [np.asarray(o, np.float32).reshape(-1, 1, 3) for o in objs]
+    rms, k, dist, rvecs, tvecs = cv2.calibrateCamera(obj3, img, size, None, None, flags=flags)
     if not (np.all(np.isfinite(k)) and k[0, 0] > 0 and k[1, 1] > 0):
         raise CalibrationError("the fit diverged: check the --board size (inner corners, e.g. 9x6)")
     per_view = []
-    for v, rv, tv in zip(img, rvecs, tvecs):
-        proj, _ = cv2.projectPoints(obj, rv, tv, k, dist)
+    for v, o, rv, tv in zip(img, obj3, rvecs, tvecs):
+        proj, _ = cv2.projectPoints(o, rv, tv, k, dist)
         per_view.append(float(np.sqrt(np.mean(np.sum((proj - v) ** 2, axis=2)))))
     d = tuple(float(c) for c in np.ravel(dist)[:5])
     cam = CameraIntrinsics(

@@ -80,15 +80,10 @@ def render_board(
     if box is None:
         return np.repeat(np.clip(grey + 0.5, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
     r0, r1, c0, c1 = box  # only the pixels the board can cover are sampled
-    x, y = (a[r0 * s : r1 * s, c0 * s : c1 * s] for a in _sample_rays(cam, s))
-    r, _ = cv2.Rodrigues(np.asarray(rvec, np.float64))
-    hom = np.column_stack([r[:, 0], r[:, 1], np.asarray(tvec, np.float64).ravel()])
-    a = np.linalg.inv(hom)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w = a[2, 0] * x + a[2, 1] * y + a[2, 2]
-        bu = (a[0, 0] * x + a[0, 1] * y + a[0, 2]) / w / square_m + 1.0  # in squares, 0 at the board's edge
-        bv = (a[1, 0] * x + a[1, 1] * y + a[1, 2]) / w / square_m + 1.0
-        on_board = (w > 0) & (bu >= -1) & (bu < cols + 2) & (bv >= -1) & (bv < rows + 2)
+    px, py, facing = plane_coords(cam, box, rvec, tvec, s)
+    with np.errstate(invalid="ignore"):
+        bu, bv = px / square_m + 1.0, py / square_m + 1.0  # in squares, 0 at the board's edge
+        on_board = facing & (bu >= -1) & (bu < cols + 2) & (bv >= -1) & (bv < rows + 2)
         in_grid = (bu >= 0) & (bu < cols + 1) & (bv >= 0) & (bv < rows + 1)
         dark = ((np.floor(bu) + np.floor(bv)) % 2 == 0) & in_grid
     patch = np.where(on_board, np.where(dark, BLACK, WHITE), BACKGROUND)
@@ -100,19 +95,56 @@ def _board_box(
     cam: CameraIntrinsics, cols: int, rows: int, square_m: float, rvec: np.ndarray, tvec: np.ndarray
 ) -> Optional[Tuple[int, int, int, int]]:
     """Pixel rows and columns ``(r0, r1, c0, c1)`` holding the whole board with its margin, or None if behind."""
+    return plane_box(cam, (-2 * square_m, -2 * square_m, (cols + 1) * square_m, (rows + 1) * square_m), rvec, tvec)
+
+
+def plane_box(
+    cam: CameraIntrinsics, rect_m: Tuple[float, float, float, float], rvec: np.ndarray, tvec: np.ndarray
+) -> Optional[Tuple[int, int, int, int]]:
+    """Pixel rows and columns ``(r0, r1, c0, c1)`` that the plane rectangle ``(x0, y0, x1, y1)`` can cover."""
     t = np.linspace(0.0, 1.0, 25)
-    x0, y0, x1, y1 = -2 * square_m, -2 * square_m, (cols + 1) * square_m, (rows + 1) * square_m
+    x0, y0, x1, y1 = rect_m
     xs = np.concatenate([x0 + (x1 - x0) * t, np.full_like(t, x1), x1 - (x1 - x0) * t, np.full_like(t, x0)])
     ys = np.concatenate([np.full_like(t, y0), y0 + (y1 - y0) * t, np.full_like(t, y1), y1 - (y1 - y0) * t])
     edge = np.column_stack([xs, ys, np.zeros_like(xs)])
     r, _ = cv2.Rodrigues(np.asarray(rvec, np.float64))
-    if np.any((edge @ r.T + np.ravel(tvec))[:, 2] <= 1e-6):
-        return None if np.all((edge @ r.T + np.ravel(tvec))[:, 2] <= 1e-6) else (0, cam.height_px, 0, cam.width_px)
+    z = (edge @ r.T + np.ravel(tvec))[:, 2]
+    if np.any(z <= 1e-6):
+        return None if np.all(z <= 1e-6) else (0, cam.height_px, 0, cam.width_px)
     uv, _ = cv2.projectPoints(edge, rvec, tvec, camera_matrix(cam), np.asarray(cam.distortion, np.float64))
     uv = uv.reshape(-1, 2)
     c0, c1 = int(max(0, np.floor(uv[:, 0].min()) - 4)), int(min(cam.width_px, np.ceil(uv[:, 0].max()) + 5))
     r0, r1 = int(max(0, np.floor(uv[:, 1].min()) - 4)), int(min(cam.height_px, np.ceil(uv[:, 1].max()) + 5))
     return (r0, r1, c0, c1) if r0 < r1 and c0 < c1 else None
+
+
+def plane_coords(
+    cam: CameraIntrinsics, box: Tuple[int, int, int, int], rvec: np.ndarray, tvec: np.ndarray, s: int
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Plane coordinates ``(X, Y)`` (m) of every sub-pixel sample in ``box``, and where the plane faces the camera."""
+    r0, r1, c0, c1 = box
+    x, y = (a[r0 * s : r1 * s, c0 * s : c1 * s] for a in _sample_rays(cam, s))
+    r, _ = cv2.Rodrigues(np.asarray(rvec, np.float64))
+    a = np.linalg.inv(np.column_stack([r[:, 0], r[:, 1], np.asarray(tvec, np.float64).ravel()]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w = a[2, 0] * x + a[2, 1] * y + a[2, 2]
+        return (a[0, 0] * x + a[0, 1] * y + a[0, 2]) / w, (a[1, 0] * x + a[1, 1] * y + a[1, 2]) / w, w > 0
+
+
+def random_pose(
+    rng: np.random.Generator, cam: CameraIntrinsics, width_m: float, centre_m: np.ndarray, max_tilt_deg: float
+) -> Tuple[np.ndarray, np.ndarray]:
+    """``(rvec, tvec)``: a target ``width_m`` wide filling 25–55 % of the frame width, tilted up to
+    ``max_tilt_deg`` about a random axis, its centre on the ray of a random pixel."""
+    tilt = math.radians(rng.uniform(5.0, max_tilt_deg))
+    axis_ang = rng.uniform(0, 2 * math.pi)
+    axis = np.array([math.cos(axis_ang), math.sin(axis_ang), 0.0])
+    spin = cv2.Rodrigues(np.array([0.0, 0.0, rng.uniform(-0.3, 0.3)]))[0]
+    r = cv2.Rodrigues(axis * tilt)[0] @ spin
+    z = cam.fx_px * width_m / (rng.uniform(0.25, 0.55) * cam.width_px)
+    target = np.array([rng.uniform(0.1, 0.9) * cam.width_px, rng.uniform(0.1, 0.9) * cam.height_px])
+    ray = np.array([(target[0] - cam.cx_px) / cam.fx_px, (target[1] - cam.cy_px) / cam.fy_px, 1.0])
+    return cv2.Rodrigues(r)[0].ravel(), ray * z - r @ centre_m
 
 
 def project_corners(
@@ -133,21 +165,10 @@ def random_views(
     corner lies at least 12 px inside the frame.
     """
     rng = np.random.default_rng(seed)
-    size_m = (cols + 1) * square_m
     centre = np.array([(cols - 1) * square_m / 2, (rows - 1) * square_m / 2, 0.0])
     views: List[BoardView] = []
     while len(views) < n:
-        tilt = math.radians(rng.uniform(5.0, max_tilt_deg))
-        axis_ang = rng.uniform(0, 2 * math.pi)
-        axis = np.array([math.cos(axis_ang), math.sin(axis_ang), 0.0])
-        spin = cv2.Rodrigues(np.array([0.0, 0.0, rng.uniform(-0.3, 0.3)]))[0]
-        r = cv2.Rodrigues(axis * tilt)[0] @ spin
-        width_frac = rng.uniform(0.25, 0.55)
-        z = cam.fx_px * size_m / (width_frac * cam.width_px)
-        target = np.array([rng.uniform(0.1, 0.9) * cam.width_px, rng.uniform(0.1, 0.9) * cam.height_px])
-        ray = np.array([(target[0] - cam.cx_px) / cam.fx_px, (target[1] - cam.cy_px) / cam.fy_px, 1.0])
-        t = ray * z - r @ centre  # the board's centre on the target pixel's (undistorted) ray
-        rvec = cv2.Rodrigues(r)[0].ravel()
+        rvec, t = random_pose(rng, cam, (cols + 1) * square_m, centre, max_tilt_deg)
         corners = project_corners(cam, cols, rows, square_m, rvec, t)
         m = 12.0
         if not (np.all(corners >= m) and np.all(corners[:, 0] <= cam.width_px - 1 - m)
