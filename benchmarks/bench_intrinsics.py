@@ -14,8 +14,10 @@ import cv2
 import numpy as np
 
 from rangebearing.core.camera_models import PRESETS, preset_intrinsics
-from rangebearing.core.intrinsics import board_points, find_corners, fit_intrinsics
+from rangebearing.core.charuco import charuco_board, find_charuco
+from rangebearing.core.intrinsics import board_points, find_corners, fit_intrinsics, fit_views
 from rangebearing.core.types import CameraIntrinsics
+from rangebearing.synth.charuco import random_charuco_views
 from rangebearing.synth.chessboard import camera_matrix, random_views
 
 CAMERAS = {
@@ -40,10 +42,23 @@ def recovery(cam: CameraIntrinsics, views: int = 15, seed: int = 11) -> str:
             f"cy {fit.camera.cy_px - cam.cy_px:+.2f} px  RMS {fit.rms_px:.3f} px  worst true corner {worst:.3f} px")
 
 
+def charuco_recovery(cam: CameraIntrinsics, views: int = 15, seed: int = 11) -> str:
+    board = charuco_board(10, 7, 0.025, 0.018, "4X4_50")
+    shots = random_charuco_views(cam, board, views, seed=seed)
+    found = [f for f in (find_charuco(cv2.cvtColor(v.image, cv2.COLOR_BGR2GRAY), board) for v in shots) if f]
+    fit = fit_views([f[0] for f in found], [f[1] for f in found], (cam.width_px, cam.height_px))
+    fx_err, fy_err = 100 * (fit.camera.fx_px / cam.fx_px - 1), 100 * (fit.camera.fy_px / cam.fy_px - 1)
+    return (f"fx {fx_err:+.3f} %  fy {fy_err:+.3f} %"
+            f"  RMS {fit.rms_px:.3f} px  ({len(found)} views, {sum(len(f[0]) for f in found)} corners)")
+
+
 def main() -> None:
     print("intrinsics recovered from 15 rendered 9x6 chessboard views at 640x480:")
     for name, cam in CAMERAS.items():
         print(f"  {name:20s} {recovery(cam)}")
+    print("the same from 15 ChArUco 10x7 views (4X4_50, some partly outside the frame):")
+    for name, cam in CAMERAS.items():
+        print(f"  {name:20s} {charuco_recovery(cam)}")
     print("\npresets (published pixel pitch and focal length); at 640x480 a 16:9 sensor loses its sides:")
     for name, p in PRESETS.items():
         full = preset_intrinsics(name, p.array_w_px, p.array_h_px)

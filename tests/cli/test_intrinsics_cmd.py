@@ -50,3 +50,22 @@ def test_bad_board_argument_is_an_argparse_error(frames, capsys):
     with pytest.raises(SystemExit):
         main(["intrinsics", str(frames), "--board", "9by6", "--square-mm", "25", "--out", "x.yaml"])
     assert "COLSxROWS" in capsys.readouterr().err
+
+
+def test_charuco_frames(tmp_path, capsys):
+    from rangebearing.core.charuco import charuco_board
+    from rangebearing.synth.charuco import random_charuco_views
+
+    d = tmp_path / "charuco"
+    d.mkdir()
+    for i, v in enumerate(random_charuco_views(TRUE, charuco_board(10, 7, 0.025, 0.018, "4X4_50"), 10, seed=4)):
+        cv2.imwrite(str(d / f"{i:06d}.png"), v.image)
+    out = tmp_path / "cam.yaml"
+    args = ["intrinsics", str(d), "--board", "10x7", "--square-mm", "25", "--out", str(out)]
+    assert main([*args, "--charuco", "4X4_50"]) == 1
+    assert "--marker-mm" in capsys.readouterr().err
+    assert main([*args, "--charuco", "4X4_50", "--marker-mm", "18"]) == 0
+    assert "board ChArUco 10x7" in capsys.readouterr().out
+    cam = load_config(out).camera
+    assert cam.fx_px == pytest.approx(TRUE.fx_px, rel=0.005)
+    assert cam.fy_px == pytest.approx(TRUE.fy_px, rel=0.005)

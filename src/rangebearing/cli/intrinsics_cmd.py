@@ -12,7 +12,8 @@ from typing import Any, List, Tuple
 import cv2
 import numpy as np
 
-from ..core.intrinsics import find_corners, fit_intrinsics
+from ..core.charuco import charuco_board, find_charuco
+from ..core.intrinsics import board_points, find_corners, fit_views
 from ..errors import CalibrationError
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import add_config_arg, add_quiet_arg, config_from_args, progress, quiet_or_auto, save_config
@@ -48,8 +49,12 @@ def register(sub: Any) -> None:
         "'rangebearing record' while moving it over the whole image and tilting it.",
     )
     p.add_argument("frames", help="directory of images or a video file")
-    p.add_argument("--board", required=True, type=_board, metavar="COLSxROWS", help="inner corners, e.g. 9x6")
+    p.add_argument("--board", required=True, type=_board, metavar="COLSxROWS",
+                   help="chessboard: inner corners, e.g. 9x6; with --charuco: squares, e.g. 10x7")
     p.add_argument("--square-mm", required=True, type=_square, metavar="MM", help="side of one square (mm)")
+    p.add_argument("--charuco", metavar="DICT", help="a ChArUco board with markers from this ArUco dictionary, "
+                   "e.g. 4X4_50 (partial views count, so the frame's edges are easier to cover)")
+    p.add_argument("--marker-mm", type=_square, metavar="MM", help="with --charuco: side of one marker (mm)")
     p.add_argument("--out", required=True, metavar="FILE", help="where to write the config (YAML)")
     p.add_argument("--k3", action="store_true", help="also fit k3 (wide-angle lenses such as pi-v3-wide)")
     add_config_arg(p)
@@ -60,8 +65,15 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     cols, rows = args.board
+    charuco = None
+    if args.charuco:
+        if args.marker_mm is None:
+            raise CalibrationError("--charuco needs --marker-mm, the side of one marker")
+        charuco = charuco_board(cols, rows, args.square_mm / 1000.0, args.marker_mm / 1000.0, args.charuco)
+    obj = board_points(cols, rows, args.square_mm / 1000.0)
     path = Path(args.frames)
     views: List[np.ndarray] = []
+    objs: List[np.ndarray] = []
     size = None
     seen = missed = 0
     try:
@@ -75,18 +87,24 @@ def run(args: argparse.Namespace) -> int:
                 size = (w, h)
             elif size != (w, h):
                 raise CalibrationError(f"{name} is {w}×{h}, the frames before it {size[0]}×{size[1]}")
-            corners = find_corners(cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), cols, rows)
-            if corners is None:
+            gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+            found = find_charuco(gray, charuco) if charuco is not None else find_corners(gray, cols, rows)
+            if found is None:
                 missed += 1
+            elif charuco is not None:
+                views.append(found[0])  # type: ignore[index]
+                objs.append(found[1])  # type: ignore[index]
             else:
-                views.append(corners)
+                views.append(found)  # type: ignore[arg-type]
+                objs.append(obj)
     except KeyboardInterrupt:
         print(f"\ninterrupted after {seen} frames ({len(views)} with the board); nothing written", file=sys.stderr)
         return 130
     if size is None:
         raise CalibrationError(f"no readable frames in {path}")
-    print(f"board {cols}x{rows} found in {len(views)} of {seen} frames ({missed} without it)")
-    fit = fit_intrinsics(views, cols, rows, args.square_mm / 1000.0, size, k3=args.k3)
+    kind = f"ChArUco {cols}x{rows} ({sum(len(v) for v in views)} corners)" if charuco is not None else f"{cols}x{rows}"
+    print(f"board {kind} found in {len(views)} of {seen} frames ({missed} without it)")
+    fit = fit_views(views, objs, size, k3=args.k3)
     cam = fit.camera
     print(f"fx {cam.fx_px:.2f} px  fy {cam.fy_px:.2f} px  cx {cam.cx_px:.2f}  cy {cam.cy_px:.2f}  "
           f"({cam.width_px}x{cam.height_px}, horizontal field of view {math.degrees(cam.hfov_rad):.1f}°)")
