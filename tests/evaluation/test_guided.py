@@ -1,5 +1,6 @@
 """``calibrate --guided`` end to end: the fake Pi camera shows where a scripted operator put the landmark."""
 
+import importlib.util
 import io
 import math
 
@@ -64,6 +65,8 @@ def test_guided_session_records_checks_fits_and_can_be_redone(setup, tmp_path, c
 
     record = tmp_path / "calibrated-recording"
     truth = read_truth(record / "truth.csv")
+    if importlib.util.find_spec("matplotlib") is not None:  # the plot is drawn when matplotlib is there
+        assert (record / "fit.png").stat().st_size > 1000
     assert len(truth) == 18 and not any(name.startswith("s03") for name in truth)
     assert (record / "plan.csv").read_text().startswith("name,range_m,bearing_deg\ns01,0.2500,0.000")
     fitted = load_config(out)
