@@ -52,7 +52,7 @@ class IdentityParams:
     """
 
     max_hidden_frames: int = 15
-    # a glimpse (fewer than rate_after_updates readings) has no rate: after this many frames unseen its
+    # a glimpse (a track of a single reading) has no rate at all: after this many frames unseen its
     # gate covers most of the view and would take the next newcomer's reading
     max_hidden_young_frames: int = 5
     gate_d2: float = 16.0  # chi-square, 2 dof: a true pair falls outside once in ~3,000
@@ -237,7 +237,7 @@ def update(
         range_rate_mps=np.where(grown, rates[:, RANGE], np.nan),
         bearing_rate_radps=np.where(grown, rates[:, BEARING], np.nan),
     )
-    limit = np.where(updates >= params.rate_after_updates, params.max_hidden_frames, params.max_hidden_young_frames)
+    limit = np.where(updates >= 2, params.max_hidden_frames, params.max_hidden_young_frames)
     keep = hidden <= limit
     if not keep.all():
         ids, x, p, hidden, updates = ids[keep], x[keep], p[keep], hidden[keep], updates[keep]
