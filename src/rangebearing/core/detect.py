@@ -77,6 +77,9 @@ def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: i
     return majority_filter(red, ksize), majority_filter(blue, ksize)
 
 
+SPACING_AGREE = (0.8, 1.25)  # band spacing / (white height · 55/40) of a real landmark
+
+
 def find_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
 ) -> List[Candidate]:
@@ -129,6 +132,11 @@ def combine(
         return None
     rows = measure_rows(bgr, c, gains, geometry, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
     if rows is None:
+        return None
+    # the band spacing and the white body's height are two measures of one size: they must agree
+    spacing_px = _y(blue.xy_px[1], rows.blue_y_px, rows.blue_merged) - _y(red.xy_px[1], rows.red_y_px, rows.red_merged)
+    expected_px = rows.white_px * geometry.band_spacing_m / (geometry.height_m - 2 * geometry.band_height_m)
+    if not SPACING_AGREE[0] <= spacing_px / max(expected_px, 1e-6) <= SPACING_AGREE[1]:
         return None
     cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
     if cols is None:

@@ -12,6 +12,7 @@ touching it) is placed from its other limb, half a silhouette away.
 
 from __future__ import annotations
 
+import math
 from typing import Optional, Tuple
 
 import numpy as np
@@ -175,6 +176,7 @@ def measure_columns(
             level = float(np.median(q[max(0, core - 2) : core + 3]))
             edge = limb(q, core, 0, level, float(q[0]))
             xs.append(ox + (edge + 0.5) * f - 0.5 + half)
-    if not xs:
+    x = float(np.mean(xs)) if xs else math.nan
+    if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
         return None
-    return float(np.mean(xs)), LIMB_SIGMA_X_PX
+    return x, LIMB_SIGMA_X_PX

@@ -40,7 +40,8 @@ WHITE_SHARE = 0.6  # share of the rows between the edges that must be white
 EDGE_STEP = 1  # largest jump of an edge between neighbouring columns (plus 5 % of h)
 MERGED = 1.7  # a band run longer than this many expected band heights is merged with something
 SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
-MIN_VISIBLE = 0.3  # narrower runs than this share of a silhouette are not reported
+MIN_VISIBLE = 0.5  # narrower runs than this share of a silhouette are not reported (findable: 60 %)
+BRIDGE = 2  # columns of a gap bridged between agreeing edges
 WHITE_S_MAX, WHITE_V_MIN = 80, 40  # the white body: low saturation, not dark
 
 
@@ -85,7 +86,7 @@ def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
 
 def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tuple[int, int]]:
     """Row indices of red and blue regions that may hold one landmark: shared columns, blue
-    starting below red's top and not farther below red's bottom than a white body could be."""
+    reaching below red's bottom and starting no farther below it than a white body could be."""
     if len(reds) == 0 or len(blues) == 0:
         return []
     rx0, ry0, rw, rh = (reds[:, k, None] for k in (1, 2, 3, 4))
@@ -93,7 +94,8 @@ def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tu
     overlap = np.minimum(rx0 + rw, bx0 + bw) - np.maximum(rx0, bx0)
     gap = by0 - (ry0 + rh)
     # a white body is 40/35 of the silhouette wide; a partly hidden one (30 % seen) shows less width
-    ok = (overlap >= 2) & (by0 > ry0) & (by0 + bh > ry0 + rh) & (gap <= 4 * np.minimum(rw, bw) + 3)
+    # blue may start above red when it merged with a blue wall behind; it must reach below red's bottom
+    ok = (overlap >= 2) & (by0 + bh > ry0 + rh) & (gap <= 4 * np.minimum(rw, bw) + 3)
     i, j = np.nonzero(ok)
     order = np.argsort(-overlap[i, j], kind="stable")[:max_pairs]
     return list(zip(i[order].tolist(), j[order].tolist()))
@@ -133,6 +135,23 @@ def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     run_r = b1 - np.take_along_axis(last_not_red, np.maximum(b1, 0)[None, :], 0)[0]
     run_b = next_not_blue[best, cols] - best
     return ok, b1, best, run_r, run_b
+
+
+def bridge(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fill gaps of up to ``BRIDGE`` columns between columns whose edges agree, and take the median
+    of three neighbours, so sensor noise neither breaks one structure into pieces nor jitters its edges."""
+    ok, y1, y2 = ok.copy(), y1.astype(np.float64), y2.astype(np.float64)
+    idx = np.flatnonzero(ok)
+    if len(idx) >= 2:
+        for a, b in zip(idx[:-1], idx[1:]):
+            if 1 < b - a <= BRIDGE + 1 and abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
+                ok[a + 1 : b] = True
+                y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
+    if len(ok) >= 3:
+        for y in (y1, y2):
+            stack = np.vstack((np.r_[y[0], y[:-1]], y, np.r_[y[1:], y[-1]]))
+            y[1:-1] = np.median(stack, axis=0)[1:-1]
+    return ok, y1, y2
 
 
 def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> List[Tuple[int, int]]:
@@ -184,9 +203,12 @@ def candidates(
         win = (slice(y0, y1), slice(x0, x1))
         white = (hsv[win][..., 1] < WHITE_S_MAX) & (hsv[win][..., 2] >= WHITE_V_MIN)
         ok, e1, e2, run_r, run_b = column_edges(red[win] > 0, blue[win] > 0, white)
+        ok, e1, e2 = bridge(ok, e1, e2)
         for s0, s1 in runs(ok, e1, e2):
             n = s1 - s0
             gap = float(np.median(e2[s0:s1] - e1[s0:s1] - 1))
+            if gap < 2:  # bridged or smoothed below the thinnest white body
+                continue
             hb, w_exp = band_k * gap, width_k * gap
             ratio = n / w_exp
             red_merged = float(np.median(run_r[s0:s1])) > MERGED * hb + 1

@@ -68,7 +68,13 @@ def match_frame(
 
 @frozen
 class AccuracyReport:
-    """Detection rate, false landmarks and error statistics over a set of frames."""
+    """Detection rate, false landmarks, error statistics and σ coverage over a set of frames.
+
+    ``findable`` counts true landmarks the truth marks findable (both bands ≥ 60 %
+    visible; all of them when the truth does not say) and ``found_findable`` those
+    detected. ``range_cover``/``bearing_cover`` are the shares of detections with
+    |error| ≤ 2σ (their own ``range_sigma_m``/``bearing_sigma_rad``); NaN without σ.
+    """
 
     frames: int
     truths: int
@@ -78,10 +84,30 @@ class AccuracyReport:
     range_err_pct_p95: float
     bearing_err_deg_mean: float
     bearing_err_deg_p95: float
+    findable: int = 0
+    found_findable: int = 0
+    empty_frames: int = 0
+    false_on_empty: int = 0
+    range_cover: float = math.nan
+    bearing_cover: float = math.nan
 
     @property
     def detection_rate(self) -> float:
         return self.detected / self.truths if self.truths else 1.0
+
+    @property
+    def findable_rate(self) -> float:
+        return self.found_findable / self.findable if self.findable else 1.0
+
+
+def _cover(hits: Sequence[Match]) -> Tuple[float, float]:
+    """Shares of hits with |error| ≤ 2σ in range and in bearing (NaN when no hit carries a σ)."""
+    with_sigma = [m for m in hits if m.found is not None and m.found.range_sigma_m > 0]
+    if not with_sigma:
+        return math.nan, math.nan
+    r = np.mean([abs(m.found.range_m - m.truth.range_m) <= 2 * m.found.range_sigma_m for m in with_sigma])
+    b = np.mean([abs(m.found.bearing_rad - m.truth.bearing_rad) <= 2 * m.found.bearing_sigma_rad for m in with_sigma])
+    return float(r), float(b)
 
 
 def accuracy(
@@ -89,15 +115,20 @@ def accuracy(
 ) -> Tuple[AccuracyReport, List[Match]]:
     """Evaluate ``(frame, detections, truths)`` triples; returns the report and every match."""
     matches: List[Match] = []
-    n_frames = n_false = 0
+    n_frames = n_false = n_empty = n_false_empty = 0
     for name, found, truths in frames:
         n_frames += 1
         m, false = match_frame(name, found, truths)
         matches.extend(m)
         n_false += len(false)
+        if not truths:
+            n_empty += 1
+            n_false_empty += len(false)
     hits = [m for m in matches if m.found is not None]
+    findable = [m for m in matches if m.truth.findable is not False]
     r = np.array([m.range_err_pct for m in hits]) if hits else np.array([math.nan])
     b = np.array([m.bearing_err_deg for m in hits]) if hits else np.array([math.nan])
+    r_cover, b_cover = _cover(hits)
     report = AccuracyReport(
         frames=n_frames,
         truths=len(matches),
@@ -107,6 +138,12 @@ def accuracy(
         range_err_pct_p95=float(np.percentile(r, 95)),
         bearing_err_deg_mean=float(np.mean(b)),
         bearing_err_deg_p95=float(np.percentile(b, 95)),
+        findable=len(findable),
+        found_findable=sum(1 for m in findable if m.found is not None),
+        empty_frames=n_empty,
+        false_on_empty=n_false_empty,
+        range_cover=r_cover,
+        bearing_cover=b_cover,
     )
     return report, matches
 
@@ -115,11 +152,14 @@ def format_report(rep: AccuracyReport) -> str:
     """A short human-readable accuracy report."""
     return "\n".join(
         [
-            f"frames            {rep.frames}",
-            f"landmarks (truth) {rep.truths}",
+            f"frames            {rep.frames} ({rep.empty_frames} without a landmark)",
+            f"landmarks (truth) {rep.truths} ({rep.findable} findable: both bands >= 60 % visible)",
             f"detected          {rep.detected} ({100.0 * rep.detection_rate:.1f} %)",
-            f"false landmarks   {rep.false_landmarks}",
+            f"findable found    {rep.found_findable} ({100.0 * rep.findable_rate:.1f} %)",
+            f"false landmarks   {rep.false_landmarks} ({rep.false_on_empty} on frames without a landmark)",
             f"range error       mean {rep.range_err_pct_mean:.2f} %   p95 {rep.range_err_pct_p95:.2f} %",
             f"bearing error     mean {rep.bearing_err_deg_mean:.3f}°  p95 {rep.bearing_err_deg_p95:.3f}°",
+            f"sigma coverage    |err| <= 2 sigma: range {100.0 * rep.range_cover:.1f} %   "
+            f"bearing {100.0 * rep.bearing_cover:.1f} %",
         ]
     )
