@@ -78,6 +78,7 @@ def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: i
 
 
 SPACING_AGREE = (0.8, 1.25)  # band spacing / (white height · 55/40) of a real landmark
+WHITE_AGREE = 1.3  # white height measured / found by the structure search (2 px steps at ½ resolution)
 
 
 def find_candidates(
@@ -137,6 +138,9 @@ def combine(
     spacing_px = _y(blue.xy_px[1], rows.blue_y_px, rows.blue_merged) - _y(red.xy_px[1], rows.red_y_px, rows.red_merged)
     expected_px = rows.white_px * geometry.band_spacing_m / (geometry.height_m - 2 * geometry.band_height_m)
     if not SPACING_AGREE[0] <= spacing_px / max(expected_px, 1e-6) <= SPACING_AGREE[1]:
+        return None
+    # ... and the white body measured here must be the one the structure search found at 1/downscale
+    if not 1 / WHITE_AGREE <= rows.white_px / max(c.white_px, 1e-6) <= WHITE_AGREE:
         return None
     cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
     if cols is None:

@@ -118,7 +118,10 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
 
 
 def limb(profile: np.ndarray, core: int, end: int, level: float, bg: float) -> float:
-    """Sub-pixel limb column from a column profile: going right when ``end > core``, else left."""
+    """Sub-pixel limb column from a column profile: going right when ``end > core``, else left;
+    NaN when the band does not stand out from what lies beyond (no limb to see)."""
+    if not level - bg > MERGE_CONTRAST * abs(level):
+        return float("nan")
     if end > core:
         return edge_down(profile, core, end, level, bg)
     return edge_up(profile, core, end, level, bg)

@@ -25,7 +25,7 @@ from .structure import Candidate
 from .types import LandmarkGeometry
 
 CENTROID_SIGMA_X_PX = 0.15  # column centroid of a whole landmark (saturation moments)
-LIMB_SIGMA_X_PX = 0.5  # a limb edge on a shaded cylinder side
+LIMB_SIGMA_X_PX = 0.8  # a limb edge on a shaded cylinder side
 MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
 
 
@@ -176,6 +176,7 @@ def measure_columns(
             level = float(np.median(q[max(0, core - 2) : core + 3]))
             edge = limb(q, core, 0, level, float(q[0]))
             xs.append(ox + (edge + 0.5) * f - 0.5 + half)
+    xs = [x for x in xs if math.isfinite(x)]
     x = float(np.mean(xs)) if xs else math.nan
     if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
         return None

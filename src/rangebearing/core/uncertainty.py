@@ -34,6 +34,7 @@ DEPTH_SHARE = 0.06  # where on the curved near surface the bands are measured: t
 HIDDEN_PX = 0.25  # extra px of L per unit of hidden share (curvature of the edges over the visible part)
 BEARING_FLOOR_RAD = math.radians(0.012)
 SHADING_SHARE = 0.008  # column bias from shading across the cylinder, share of the silhouette width
+HIDDEN_SHARE = 0.05  # column error per unit of hidden share, in silhouette widths (the visible part's centre)
 
 
 def range_sigma_m(
@@ -46,9 +47,12 @@ def range_sigma_m(
     return math.sqrt(spacing**2 + (MODEL_FLOOR * range_m) ** 2 + (DEPTH_SHARE * radius_m) ** 2)
 
 
-def bearing_sigma_rad(bearing_rad: float, sigma_x_px: float, width_px: float, fx_px: float) -> float:
+def bearing_sigma_rad(
+    bearing_rad: float, sigma_x_px: float, width_px: float, fx_px: float, visible: float = 1.0
+) -> float:
     """One-sigma bearing error (rad) of a landmark ``width_px`` wide whose column is known to ``sigma_x_px``."""
-    s_x = math.hypot(sigma_x_px, SHADING_SHARE * width_px)
+    hidden = HIDDEN_SHARE * (1.0 - min(1.0, visible)) * width_px / max(visible, 0.3)
+    s_x = math.sqrt(sigma_x_px**2 + (SHADING_SHARE * width_px) ** 2 + hidden**2)
     return math.hypot(math.cos(bearing_rad) ** 2 * s_x / fx_px, BEARING_FLOOR_RAD)
 
 
@@ -59,5 +63,5 @@ def reading_sigma(
     """``(range_sigma_m, bearing_sigma_rad)`` of one reading."""
     return (
         range_sigma_m(range_m, c_m, l_px, sigma_l_px, visible),
-        bearing_sigma_rad(bearing_rad, sigma_x_px, width_px, fx_px),
+        bearing_sigma_rad(bearing_rad, sigma_x_px, width_px, fx_px, visible),
     )
