@@ -142,11 +142,12 @@ def bridge(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> Tuple[np.ndarray, 
     of three neighbours, so sensor noise neither breaks one structure into pieces nor jitters its edges."""
     ok, y1, y2 = ok.copy(), y1.astype(np.float64), y2.astype(np.float64)
     idx = np.flatnonzero(ok)
-    if len(idx) >= 2:
-        for a, b in zip(idx[:-1], idx[1:]):
-            if 1 < b - a <= BRIDGE + 1 and abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
-                ok[a + 1 : b] = True
-                y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
+    gaps = np.flatnonzero((np.diff(idx) > 1) & (np.diff(idx) <= BRIDGE + 1))  # usually none
+    for g in gaps.tolist():
+        a, b = idx[g], idx[g + 1]
+        if abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
+            ok[a + 1 : b] = True
+            y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
     if len(ok) >= 3:
         for y in (y1, y2):
             stack = np.vstack((np.r_[y[0], y[:-1]], y, np.r_[y[1:], y[-1]]))
