@@ -55,23 +55,35 @@ def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
     h, w = bgr.shape[:2]
     f = max(1, min(h // 30, w // 40))
     tiny = cv2.resize(bgr, (max(1, w // f), max(1, h // f)), interpolation=cv2.INTER_AREA) if f > 1 else bgr
-    p = tiny.reshape(-1, 3).T.astype(np.float32)  # (3, N): channel rows are cheap to combine
-    mx = np.maximum(np.maximum(p[0], p[1]), p[2])
-    p = p[:, (mx >= DARK) & (mx <= CLIPPED)]
-    gains = np.ones(3, np.float32)
-    if p.shape[1] == 0:
-        return UNIT_GAINS
+    pixels = tiny.reshape(-1, 3).astype(np.float32)
+    gains = np.ones(3, np.float64)
     for _ in range(BALANCE_ITERATIONS):
-        q = p * gains[:, None]
-        hi = np.maximum(np.maximum(q[0], q[1]), q[2])
-        lo = np.minimum(np.minimum(q[0], q[1]), q[2])
-        wgt = np.exp(-np.square((hi - lo) / (hi * NEUTRAL_SAT)))
-        total = float(wgt.sum())
-        if total < 1e-3 * p.shape[1]:  # nothing near neutral: keep what we have
+        q = apply_gains(tiny, tuple(gains)) if (gains != 1.0).any() else tiny
+        _, s, v = cv2.split(cv2.cvtColor(q, cv2.COLOR_BGR2HSV))
+        # weight: neutral-ness from S (after the gains), zero for dark or clipped V (one table each)
+        wgt = cv2.multiply(cv2.LUT(s, _neutral_table()), cv2.LUT(v, _valid_table()), scale=1.0 / 255.0)
+        wv = wgt.reshape(-1).astype(np.float32)
+        total = float(wv.sum())
+        if total < 1e-3 * 255.0 * len(wv):  # nothing near neutral: keep what we have
             break
-        mean = (q @ wgt) / total
-        gains = np.clip(gains * mean.mean() / np.maximum(mean, 1e-3), 1.0 / limit, limit).astype(np.float32)
+        mean = (wv @ pixels) / total * gains  # the balanced colour of the neutral surfaces
+        gains = np.clip(gains * mean.mean() / np.maximum(mean, 1e-3), 1.0 / limit, limit)
     return tuple(float(g) for g in gains)  # type: ignore[return-value]
+
+
+@functools.lru_cache(maxsize=1)
+def _neutral_table() -> np.ndarray:
+    """uint8 LUT over S (0–255): 255·exp(-(S/255 / NEUTRAL_SAT)²)."""
+    s = np.arange(256, dtype=np.float64) / 255.0
+    return np.round(255.0 * np.exp(-np.square(s / NEUTRAL_SAT))).astype(np.uint8).reshape(256, 1)
+
+
+@functools.lru_cache(maxsize=1)
+def _valid_table() -> np.ndarray:
+    """uint8 LUT over V: 255 where DARK ≤ V ≤ CLIPPED, else 0."""
+    t = np.zeros((256, 1), np.uint8)
+    t[DARK : CLIPPED + 1] = 255
+    return t
 
 
 def apply_gains(bgr: np.ndarray, gains: Gains) -> np.ndarray:

@@ -121,18 +121,19 @@ def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     blue_top[1:] &= ~blue[:-1]
     blue_top[0] = False
     cum_w = np.cumsum(white, axis=0, dtype=np.int32)
-    y2 = np.broadcast_to(rows, (h, w))
-    y1 = np.vstack((np.full((1, w), -1, np.int32), last_rb[:-1]))
     cols = np.arange(w)
-    safe_y1 = np.maximum(y1, 0)
-    gap = y2 - y1 - 1
-    whites = np.take_along_axis(cum_w, np.maximum(y2 - 1, 0), 0) - np.take_along_axis(cum_w, safe_y1, 0)
+    y1 = np.empty_like(last_rb)
+    y1[0], y1[1:] = -1, last_rb[:-1]  # the last red bottom above each row
+    gap = rows - y1 - 1
+    whites = np.empty_like(cum_w)  # white rows strictly between y1 and this row
+    whites[0] = 0
+    whites[1:] = cum_w[:-1] - cum_w[np.maximum(y1[1:], 0), cols]
     valid = blue_top & (y1 >= 0) & (gap >= 2) & (whites >= WHITE_SHARE * gap)
     share = np.where(valid, whites / np.maximum(gap, 1) - 1e-3 * gap, -1.0)
     best = np.argmax(share, axis=0)
     ok = share[best, cols] > -1.0
     b1 = y1[best, cols]
-    run_r = b1 - np.take_along_axis(last_not_red, np.maximum(b1, 0)[None, :], 0)[0]
+    run_r = b1 - last_not_red[np.maximum(b1, 0), cols]
     run_b = next_not_blue[best, cols] - best
     return ok, b1, best, run_r, run_b
 
@@ -150,8 +151,8 @@ def bridge(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> Tuple[np.ndarray, 
             y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
     if len(ok) >= 3:
         for y in (y1, y2):
-            stack = np.vstack((np.r_[y[0], y[:-1]], y, np.r_[y[1:], y[-1]]))
-            y[1:-1] = np.median(stack, axis=0)[1:-1]
+            a, b, c = y[:-2], y[1:-1], y[2:]
+            y[1:-1] = np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))  # median of three
     return ok, y1, y2
 
 
