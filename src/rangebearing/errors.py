@@ -86,3 +86,21 @@ class RequestError(RangeBearingError, ValueError):
 
 class ServeError(RangeBearingError, OSError):
     """The view's web server cannot listen on the address asked for."""
+
+
+class MissingExtraError(RangeBearingError, ImportError):
+    """An optional extra (zenoh, mcap) is not installed; the message says what to pip install."""
+
+    def __init__(self, extra: str, module: str, feature: str) -> None:
+        self.extra = extra
+        super().__init__(
+            f"{feature} needs the optional package {module!r}: pip install 'rangebearing[{extra}]'"
+        )
+
+
+class TransportError(RangeBearingError, OSError):
+    """A Zenoh session cannot be opened or declared (bad endpoint, no router in client mode)."""
+
+
+class RecordingError(RangeBearingError, OSError):
+    """An MCAP recording cannot be written or read (not MCAP, missing channels, I/O failure)."""

@@ -106,3 +106,31 @@ def test_cli_reports_bad_config_without_traceback(tmp_path):
     assert proc.stderr.startswith("rangebearing: error:")
     assert "camera.fx_px" in proc.stderr and "detection.downscale" in proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_zenoh_section_defaults_off_and_round_trips():
+    cfg = load_config(ROOT / "config" / "rangebearing.yaml")
+    z = cfg.publish.zenoh
+    assert not z.enabled and z.mode == "peer" and z.connect == () and z.listen == ()
+    assert z.scouting_multicast and z.key == "rangebearing/{robot}/readings"
+    on = config_from_mapping({"publish": {"robot_id": "zumo4", "zenoh": {
+        "enabled": True, "mode": "client", "connect": ["tcp/10.0.0.1:7447"], "scouting_multicast": False}}})
+    assert on.publish.zenoh.connect == ("tcp/10.0.0.1:7447",) and on.publish.unicast == (("127.0.0.1", 47800),)
+    assert load_config_text(dump_config(on)).publish == on.publish
+
+
+def test_every_zenoh_problem_is_named():
+    with pytest.raises(ConfigError) as err:
+        config_from_mapping({"publish": {"robot_id": "zumo1", "zenoh": {
+            "enabled": "yes", "mode": "router", "connect": ["10.0.0.1:7447"], "listen": "tcp/0.0.0.0:7447",
+            "key": "rangebearing/*/readings", "colour": 1}}})
+    msg = str(err.value)
+    for key in ("publish.zenoh.enabled", "publish.zenoh.mode", "publish.zenoh.connect", "publish.zenoh.listen",
+                "publish.zenoh.key", "publish.zenoh.colour"):
+        assert key in msg, key
+    assert len(err.value.problems) == 6
+    with pytest.raises(ConfigError) as err:  # robot ids are plain names, so each is one Zenoh key chunk
+        config_from_mapping({"publish": {"robot_id": "a/b", "zenoh": {"enabled": True, "mode": "client"}}})
+    assert "publish.robot_id" in str(err.value) and "client mode needs" in str(err.value)
+    with pytest.raises(ConfigError, match="must contain"):
+        config_from_mapping({"publish": {"zenoh": {"key": "rangebearing/readings"}}})

@@ -18,11 +18,13 @@ from typing import TYPE_CHECKING, Dict, Iterable, Iterator, List, Optional, Type
 from ..config import Config, SourceConfig, dump_config, load_config
 from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
+from ..net.zenoh_transport import ZenohSettings
 
 if TYPE_CHECKING:
     from ..evaluation.truth import TruthRow
 
 T = TypeVar("T")
+DEFAULT_ZENOH_LISTEN = "tcp/127.0.0.1:7447"  # a controller on this machine; tcp/0.0.0.0:7447 for a lab
 
 
 def add_config_arg(p: argparse.ArgumentParser) -> None:
@@ -210,13 +212,20 @@ def format_reading(reading: Reading) -> str:
 def aligned_truth(frames_path: Union[str, Path], truth_path: Union[str, Path]) -> Dict[str, List[TruthRow]]:
     """The truth CSV keyed by the frames' own names (see :func:`~rangebearing.evaluation.truth.align_truth`).
 
-    A video's frames are named by their 0-based index, as ``replay`` prints them: ``0``, ``1``, …
+    A video's (and an MCAP file's) frames are named by their 0-based index, as ``replay`` prints them:
+    ``0``, ``1``, …; MCAP truth may also name a frame by its capture timestamp in integer Unix ns.
     """
     from ..evaluation.truth import align_truth, read_truth
+    from ..sources.mcap_frames import is_mcap_file
     from ..sources.recorded import count_recorded, list_images
 
     truth = read_truth(truth_path)
     path = Path(frames_path)
+    if path.is_file() and is_mcap_file(path):  # MCAP truth may name frames by capture time (ns)
+        from ..evaluation.truth import key_by_position
+        from ..sources.mcap_frames import frame_times_ns
+
+        truth = key_by_position(truth, frame_times_ns(path))
     if path.is_dir():
         names = [p.name for p in list_images(path)]
     else:
@@ -225,3 +234,25 @@ def aligned_truth(frames_path: Union[str, Path], truth_path: Union[str, Path]) -
             n = 1 + max((int(k) for k in truth if k.strip().isdigit()), default=-1)
         names = [str(i) for i in range(n)]
     return align_truth(truth, names, str(truth_path))
+
+
+def add_zenoh_args(p: argparse.ArgumentParser, default_listen: Optional[str]) -> None:
+    """The options that say how to join a Zenoh network (shared with ``listen --zenoh``)."""
+    p.add_argument("--mode", choices=("peer", "client"), default="peer", help="Zenoh session mode (default peer)")
+    p.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                   help="dial a peer or router, e.g. tcp/10.0.0.1:7447 (repeatable)")
+    p.add_argument("--listen", action="append", default=[], metavar="ENDPOINT",
+                   help=f"accept peers on this endpoint (repeatable; default {default_listen or 'none'}; "
+                        "tcp/0.0.0.0:7447 hears the whole network)")
+    p.add_argument("--scout", action="store_true",
+                   help="find peers by multicast scouting on the local network (off by default)")
+    p.add_argument("--key", default="rangebearing/*/readings",
+                   help="key expression to subscribe to (default rangebearing/*/readings: every robot)")
+
+
+def settings_from_args(args: argparse.Namespace, default_listen: Optional[str]) -> ZenohSettings:
+    """Zenoh settings from the command line; with --connect and no --listen, Zenoh's own default listen."""
+    quiet = default_listen and args.mode == "peer" and not args.connect
+    listen = tuple(args.listen) or ((default_listen,) if quiet else ())
+    return ZenohSettings(mode=args.mode, connect=tuple(args.connect), listen=listen,
+                         scouting_multicast=bool(args.scout))

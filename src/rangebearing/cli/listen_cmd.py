@@ -12,7 +12,7 @@ from typing import Any, Optional, TextIO
 from ..config import DEFAULT_PORT
 from ..errors import ConfigError, NoReadingError, SubscribeError
 from ..net.client import Subscriber
-from .common import format_reading
+from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, format_reading, settings_from_args
 
 DESCRIPTION = """\
 Listen for rangebearing readings and print one line per frame:
@@ -22,6 +22,10 @@ Listen for rangebearing readings and print one line per frame:
 Bearings are positive to the left of the camera's optical axis. Every daemon
 sends a reading for every frame, so silence means no daemon is publishing here.
 Exits 0 on Ctrl-C or after --count readings, 1 if --timeout passes in silence.
+
+With --zenoh, subscribe over Eclipse Zenoh instead of UDP (the same readings;
+needs the zenoh extra): by default as a peer listening on tcp/127.0.0.1:7447
+for daemons that dial it, or --connect to a router or a robot.
 """
 
 
@@ -77,6 +81,8 @@ def register(subparsers: Any) -> None:
         metavar="S",
         help="exit 1 if no reading arrives for S seconds (default: wait forever)",
     )
+    p.add_argument("--zenoh", action="store_true", help="subscribe over Zenoh instead of UDP (see below)")
+    add_zenoh_args(p, DEFAULT_ZENOH_LISTEN)
     p.set_defaults(func=run)
 
 
@@ -90,11 +96,12 @@ def _one_line_json(data: bytes) -> str:
 
 
 def echo(
-    sub: Subscriber,
+    sub: Any,
     out: TextIO,
     as_json: bool = False,
     count: Optional[int] = None,
     timeout_s: Optional[float] = None,
+    where: Optional[str] = None,
 ) -> int:
     """Print readings from ``sub`` to ``out``; 0 after ``count`` readings.
 
@@ -107,7 +114,7 @@ def echo(
     while count is None or shown < count:
         got = sub.recv_datagram(timeout_s)
         if got is None:
-            where = f"{sub.group or sub.address[0]}:{sub.port}"
+            where = where or f"{sub.group or sub.address[0]}:{sub.port}"
             raise NoReadingError(
                 f"no reading arrived on {where} within {timeout_s:g} s"
                 + (f" ({sub.dropped} invalid datagrams dropped)" if sub.dropped else "")
@@ -124,16 +131,23 @@ def run(args: argparse.Namespace) -> int:
     if args.interface is not None and not args.group:
         raise ConfigError(["--interface only applies with --group"], "command line")
     where = f"{args.group or args.host}:{args.port}"
-    try:
-        sub = Subscriber(port=args.port, host=args.host, group=args.group, interface=args.interface or "127.0.0.1")
-    except SubscribeError:
-        raise
-    except OSError as exc:
-        raise SubscribeError(f"cannot listen on {where}: {exc.strerror or exc}") from None
+    if args.zenoh:
+        from ..net.zenoh_client import ZenohSubscriber
+
+        sub: Any = ZenohSubscriber(args.key, settings_from_args(args, DEFAULT_ZENOH_LISTEN), presence=False)
+        where = f"zenoh {args.key}"
+    else:
+        try:
+            sub = Subscriber(port=args.port, host=args.host, group=args.group,
+                             interface=args.interface or "127.0.0.1")
+        except SubscribeError:
+            raise
+        except OSError as exc:
+            raise SubscribeError(f"cannot listen on {where}: {exc.strerror or exc}") from None
     if isinstance(sys.stdout, io.TextIOWrapper):  # a terminal that cannot show a character gets an escape
         sys.stdout.reconfigure(errors="backslashreplace")
     try:
         with sub:
-            return echo(sub, sys.stdout, args.json, args.count, args.timeout)
+            return echo(sub, sys.stdout, args.json, args.count, args.timeout, where)
     except KeyboardInterrupt:  # Ctrl-C is how a user ends listening: not a failure
         return 0

@@ -23,11 +23,12 @@ from ..errors import ConfigError, RangeBearingError
 
 # name -> one-line help; the module cli/<name>_cmd.py has register(subparsers) and sets func=run.
 COMMANDS: Dict[str, str] = {
-    "run": "run the daemon: camera → pipeline → UDP readings",
+    "run": "run the daemon: camera → pipeline → UDP (and Zenoh) readings",
     "listen": "print readings published by rangebearing daemons",
     "replay": "run the pipeline over recorded frames",
     "calibrate": "fit the range model to frames with known range and bearing",
-    "record": "save frames from a source as numbered images",
+    "record": "save frames from a source as numbered images or one MCAP file",
+    "swarm": "live view of every robot's presence and readings",
     "synth": "render synthetic frames with exact ground truth",
     "intrinsics": "camera intrinsics and lens distortion from chessboard frames",
     "tune": "lock exposure and white balance and fit the colour thresholds to a landmark in view",

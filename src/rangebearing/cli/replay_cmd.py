@@ -26,11 +26,13 @@ def register(sub: Any) -> None:
     p = sub.add_parser(
         "replay",
         help="run the pipeline over recorded frames",
-        description="Run the pipeline over a directory of images (sorted by name) or a video file. "
-        "Prints one line of readings per frame; --truth adds an accuracy report, and with --track and a truth "
-        "that names each landmark's robot (synth's robot column), a track-id report (id switches, returns).",
+        description="Run the pipeline over a directory of images (sorted by name), a video file or an "
+        "MCAP recording (its /camera/image frames). Prints one line of readings per frame; --truth adds "
+        "an accuracy report (for a video or MCAP file its frame column is the 0-based frame position, "
+        "or for MCAP the frame's capture timestamp in integer Unix nanoseconds), and with --track and a "
+        "truth that names each landmark's robot (synth's robot column), a track-id report (id switches, returns).",
     )
-    p.add_argument("path", help="directory of .png/.jpg/.jpeg/.bmp images, or a video file")
+    p.add_argument("path", help="directory of .png/.jpg/.jpeg/.bmp images, a video file, or FILE.mcap")
     add_config_arg(p)
     p.add_argument("--out", metavar="FILE", help="write JSON Lines, one object per frame")
     p.add_argument("--annotate", metavar="DIR", help="write each frame with bands, centroids, range and bearing drawn")
@@ -48,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     truth = aligned_truth(args.path, args.truth) if args.truth else None
     pipe = Pipeline(cfg.pipeline, track=args.track)
     path = Path(args.path)
-    is_video = path.is_file()
+    is_video = path.is_file()  # a video or an MCAP recording: frames are named by position
     inputs = (args.path, args.truth, getattr(args, "config", None))
     if args.out:  # checked before anything is written: never over an input, never over a file unasked
         check_output_file(args.out, "--out", inputs, args.overwrite)

@@ -13,8 +13,9 @@ from ..config import Config, check
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
 from ..errors import ConfigError
+from ..net.fanout import FanOut, Shared
 from ..net.protocol import decode_reading
-from ..net.publisher import UdpPublisher
+from ..net.publisher import Publisher, UdpPublisher
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
 from .common import add_config_arg, add_source_args, config_from_args, format_reading, source_from_args
@@ -38,7 +39,38 @@ def register(sub: Any) -> None:
     p.add_argument("--echo", action="store_true", help="print every reading sent, one line per frame")
     p.add_argument("--json", action="store_true", help="with --echo, print the datagrams as sent")
     p.add_argument("--check", action="store_true", help="validate the config and exit")
+    p.add_argument("--record", metavar="FILE.mcap", default=None,
+                   help="also record every frame and reading into an MCAP file (needs the mcap extra; "
+                        "a writer thread, never slowing or stopping the loop)")
+    p.add_argument("--record-max-mb", type=_megabytes, default=None, metavar="N",
+                   help="rotate at N MB: the full file becomes FILE.1.mcap (replacing the previous one), "
+                        "so at most ~2N MB of the latest frames are kept (default: no limit)")
+    p.add_argument("--record-format", choices=("jpeg", "png"), default="jpeg",
+                   help="how recorded frames are stored (default jpeg; png is lossless and ~5x larger)")
     p.set_defaults(func=run)
+
+
+def _megabytes(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of megabytes") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def recorder_for(args: argparse.Namespace, cfg: Config) -> Optional[Any]:
+    """The MCAP writer thread for ``--record``, or None."""
+    if args.record is None:
+        if args.record_max_mb is not None:
+            raise ConfigError(["--record-max-mb needs --record FILE.mcap"], "command line")
+        return None
+    from ..recording.background import BackgroundRecorder
+
+    max_bytes = None if args.record_max_mb is None else int(args.record_max_mb * 1e6)
+    return BackgroundRecorder(args.record, cfg.camera, max_bytes=max_bytes, image_format=args.record_format,
+                              logger=logging.getLogger("rangebearing.record"))
 
 
 def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
@@ -48,6 +80,33 @@ def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
 def publisher_for(cfg: Config) -> UdpPublisher:
     """The UDP publisher; a destination that does not resolve yet is retried in the background."""
     return UdpPublisher(cfg.publish, logging.getLogger("rangebearing.publish"))
+
+
+class Publishers:
+    """UDP, plus Zenoh when ``publish.zenoh.enabled``; a reload that leaves the Zenoh settings
+    and the robot id alone keeps the same Zenoh session, so presence does not flicker."""
+
+    def __init__(self) -> None:
+        self._zenoh: Optional[Shared] = None
+        self._zenoh_for: Any = None
+
+    def __call__(self, cfg: Config) -> Publisher:
+        udp = publisher_for(cfg)
+        z = cfg.publish.zenoh
+        if not z.enabled:
+            return udp
+        wanted = (z, cfg.publish.robot_id)
+        try:
+            if self._zenoh is None or self._zenoh_for != wanted:
+                from ..net.zenoh_transport import ZenohPublisher, ZenohSettings
+
+                zp = ZenohPublisher(cfg.publish.robot_id, ZenohSettings.from_config(z), key=z.key, wait_s=1.0,
+                                    logger=logging.getLogger("rangebearing.publish"))
+                self._zenoh, self._zenoh_for = Shared(zp), wanted
+            return FanOut([udp, self._zenoh.handle()])
+        except BaseException:
+            udp.close()
+            raise
 
 
 def reloader(args: argparse.Namespace) -> Optional[Callable[[], Config]]:
@@ -81,26 +140,41 @@ def run(args: argparse.Namespace) -> int:
         if pending:  # `run` would start and keep retrying these; --check says so
             raise ConfigError([f"{p} (run would start without it and keep retrying)" for p in pending],
                               cfg.source_file)
+        if cfg.publish.zenoh.enabled:  # Zenoh itself accepts the endpoints (needs the extra)
+            from ..net.zenoh_transport import ZenohSettings
+
+            ZenohSettings.from_config(cfg.publish.zenoh).zenoh_config()
         print(f"{cfg.source_file}: OK")
         return 0
     echo = None
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
     view = start_view_for(cfg, cfg.daemon.view_host, cfg.daemon.view_port, cfg.daemon.view_fps, args.config)
+    recorder = None
     try:
+        recorder = recorder_for(args, cfg)
         daemon = Daemon(
-            cfg, source_opener, publisher_for, Notifier(), reload=reloader(args), echo=echo,
-            view=view.hub if view else None,
+            cfg, source_opener, Publishers(), Notifier(), reload=reloader(args), echo=echo,
+            view=view.hub if view else None, recorder=recorder,
         )
         daemon.install_signal_handlers()
         dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)
         if cfg.publish.multicast_group:
             dests += f", multicast {cfg.publish.multicast_group}:{cfg.publish.multicast_port}"
+        z = cfg.publish.zenoh
+        if z.enabled:
+            dests += f", zenoh {z.mode} {z.key.replace('{robot}', cfg.publish.robot_id)}"
         log.info("starting: source %s, publishing to %s", cfg.source.kind, dests or "nowhere")
         status = daemon.run()
     finally:
         if view is not None:
             view.close()
+        if recorder is not None:
+            recorder.close()  # the daemon closed it already, unless it never started
+            c = recorder.counts
+            log.info("recorded %d frames and %d readings to %s (%d dropped, %d rotations)%s", c["frames"],
+                     c["readings"], args.record, c["dropped"], c["rotations"],
+                     f"; stopped early: {recorder.failed}" if recorder.failed else "")
     if daemon.guard.wedged:  # a capture call never returned: its thread would hold the interpreter's exit
         log.warning("a capture call is still blocked in the camera stack; leaving without waiting for it")
         logging.shutdown()

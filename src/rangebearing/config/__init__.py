@@ -8,7 +8,7 @@
 from __future__ import annotations
 
 from .load import check, config_from_mapping, config_to_mapping, dump_config, load_config
-from .schema import DEFAULT_PORT, SCHEMA, SOURCES, Config, DaemonConfig, PublishConfig, SourceConfig
+from .schema import DEFAULT_PORT, SCHEMA, SOURCES, Config, DaemonConfig, PublishConfig, SourceConfig, ZenohConfig
 
 __all__ = [
     "DEFAULT_PORT",
@@ -18,6 +18,7 @@ __all__ = [
     "DaemonConfig",
     "PublishConfig",
     "SourceConfig",
+    "ZenohConfig",
     "check",
     "config_from_mapping",
     "config_to_mapping",

@@ -239,3 +239,43 @@ def is_ipv4_multicast(text: str) -> bool:
         return ipaddress.IPv4Address(text).is_multicast
     except (ipaddress.AddressValueError, ValueError):
         return False
+
+
+class Section:
+    """A nested section (``publish.zenoh``): the loader checks its keys one by one and names each."""
+
+    def __init__(self, cls: type, checks: Mapping[str, Check]) -> None:
+        self.cls = cls
+        self.checks = dict(checks)
+
+
+# <protocol>/<address>[?<metadata>][#<config>], as Zenoh spells endpoints.
+ENDPOINT = re.compile(r"^[a-z][a-z0-9+-]*/[^\s?#/][^\s?#]*(\?[^\s#]*)?(#\S*)?$")
+_KEY_BAD = re.compile(r"[*$?#\s]|//|^/|/$")
+_CHUNK_BAD = re.compile(r"[/*$?#\s]")
+
+
+def is_key_chunk(text: str) -> bool:
+    """True when ``text`` can stand for ``{robot}`` in a Zenoh key (one chunk, no wildcard)."""
+    return bool(text) and not _CHUNK_BAD.search(text)
+
+
+def endpoints(v: Any) -> Tuple[str, ...]:
+    if v is None:
+        return ()
+    if not isinstance(v, (list, tuple)):
+        raise ValueError(f"expected a list of endpoints like 'tcp/192.168.1.10:7447', got {v!r}")
+    bad = [e for e in v if not isinstance(e, str) or not ENDPOINT.match(e)]
+    if bad:
+        raise ValueError(f"{', '.join(repr(e) for e in bad)}: not <protocol>/<address> like 'tcp/192.168.1.10:7447'")
+    return tuple(v)
+
+
+def key_template(v: Any) -> str:
+    """A Zenoh key to put on, where ``{robot}`` stands for the robot id: no wildcards."""
+    text = string(v)
+    if "{robot}" not in text:
+        raise ValueError(f"{text!r} must contain {{robot}} so that robots do not share a key")
+    if _KEY_BAD.search(text.replace("{robot}", "x")):
+        raise ValueError(f"{text!r} is not a plain Zenoh key (no *, $, ?, #, spaces, empty or outer '/')")
+    return text

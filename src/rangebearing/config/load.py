@@ -40,31 +40,7 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
         if name not in SCHEMA:
             problems.append(f"unknown section {ck.show(name)} (known: {', '.join(SCHEMA)})")
     for name, (_cls, checks) in SCHEMA.items():
-        current = getattr(base, name)
-        raw = data.get(name)
-        if raw is None:
-            sections[name] = current
-            continue
-        if not isinstance(raw, Mapping):
-            problems.append(f"{name}: must be a mapping, got {ck.show(raw)}")
-            sections[name] = current
-            continue
-        values: Dict[str, Any] = {}
-        listed = False  # the known keys are listed once per section: a misplaced block would repeat them
-        for key, val in raw.items():
-            if key not in checks:
-                known = [*checks, *PRESET_KEYS] if name == "camera" else list(checks)
-                hint = "known keys above" if listed else f"known: {', '.join(known)}"
-                problems.append(f"{name}.{_key(key)}: unknown key ({hint})")
-                listed = True
-                continue
-            try:
-                values[key] = checks[key](val)
-            except ck.Invalid as exc:  # every bad entry of a list, each named
-                problems.extend(f"{name}.{key}{where}: {msg}" for where, msg in exc.problems)
-            except (ValueError, TypeError) as exc:
-                problems.append(f"{name}.{key}: {exc}")
-        sections[name] = dataclasses.replace(current, **values)
+        sections[name] = _section(name, getattr(base, name), data.get(name), checks, problems)
     cfg = Config(**sections, source_file=source)
     problems.extend(_cross_checks(cfg))
     if problems:
@@ -75,6 +51,34 @@ def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Conf
 def _key(key: Any) -> str:
     """A YAML key as a message shows it: plain when it is short text, else cut and quoted."""
     return key if isinstance(key, str) and key.isprintable() and len(key) <= 40 else ck.show(key)
+
+
+def _section(name: str, current: Any, raw: Any, checks: Mapping[str, Any], problems: list) -> Any:
+    """``current`` with the checked values of ``raw``; each problem is named ``name.key``."""
+    if raw is None:
+        return current
+    if not isinstance(raw, Mapping):
+        problems.append(f"{name}: must be a mapping, got {ck.show(raw)}")
+        return current
+    values: Dict[str, Any] = {}
+    listed = False  # the known keys are listed once per section: a misplaced block would repeat them
+    for key, val in raw.items():
+        if key not in checks:
+            known = [*checks, *PRESET_KEYS] if name == "camera" else list(checks)
+            hint = "known keys above" if listed else f"known: {', '.join(known)}"
+            problems.append(f"{name}.{_key(key)}: unknown key ({hint})")
+            listed = True
+            continue
+        if isinstance(checks[key], ck.Section):  # a nested section: publish.zenoh
+            values[key] = _section(f"{name}.{key}", getattr(current, key), val, checks[key].checks, problems)
+            continue
+        try:
+            values[key] = checks[key](val)
+        except ck.Invalid as exc:  # every bad entry of a list, each named
+            problems.extend(f"{name}.{key}{where}: {msg}" for where, msg in exc.problems)
+        except (ValueError, TypeError) as exc:
+            problems.append(f"{name}.{key}: {exc}")
+    return dataclasses.replace(current, **values)
 
 
 def check(cfg: Config) -> None:
@@ -109,6 +113,9 @@ def _cross_checks(cfg: Config) -> list[str]:
         p.append(f"source.timeout_s × source.retries: {budget_s:g} s without a frame before the daemon gives up; "
                  f"at most {MAX_CAPTURE_BUDGET_S:g} s, clearly inside the service's WatchdogSec=20s")
     p.extend(_datagram_fits(cfg))
+    z = cfg.publish.zenoh
+    if z.enabled and z.mode == "client" and not z.connect:
+        p.append("publish.zenoh.connect: client mode needs a router (or peer) endpoint to connect to")
     return p
 
 
@@ -164,13 +171,17 @@ def config_to_mapping(cfg: Config) -> Dict[str, Any]:
         ("source", "controls"): lambda v: {k: plain(x) for k, x in v},
         ("publish", "unicast"): lambda v: [f"{h}:{p}" for h, p in v],
     }
-    out: Dict[str, Any] = {}
-    for name in SCHEMA:
-        section = getattr(cfg, name)
-        out[name] = {}
-        for key in SCHEMA[name][1]:
-            out[name][key] = special.get((name, key), plain)(getattr(section, key))
-    return out
+    def mapping(name: str, section: Any, checks: Mapping[str, Any]) -> Dict[str, Any]:
+        out: Dict[str, Any] = {}
+        for key, chk in checks.items():
+            value = getattr(section, key)
+            if isinstance(chk, ck.Section):
+                out[key] = mapping(f"{name}.{key}", value, chk.checks)
+            else:
+                out[key] = special.get((name, key), plain)(value)
+        return out
+
+    return {name: mapping(name, getattr(cfg, name), SCHEMA[name][1]) for name in SCHEMA}
 
 
 def dump_config(cfg: Config) -> str:

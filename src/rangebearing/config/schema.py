@@ -45,8 +45,20 @@ class SourceConfig:
 
 
 @frozen
+class ZenohConfig:
+    """``publish.zenoh``: also publish every reading over Eclipse Zenoh (opt-in; docs/swarm.md)."""
+
+    enabled: bool = False
+    mode: str = "peer"  # peer | client
+    connect: Tuple[str, ...] = ()  # routers or peers to dial, e.g. "tcp/192.168.1.10:7447"
+    listen: Tuple[str, ...] = ()  # empty: Zenoh's default for the mode (every interface)
+    scouting_multicast: bool = True  # find peers on the local network
+    key: str = "rangebearing/{robot}/readings"
+
+
+@frozen
 class PublishConfig:
-    """Where readings go: unicast destinations and an opt-in multicast group."""
+    """Where readings go: unicast destinations, an opt-in multicast group, opt-in Zenoh."""
 
     robot_id: str = "zumo"
     unicast: Tuple[Tuple[str, int], ...] = (("127.0.0.1", DEFAULT_PORT),)
@@ -54,6 +66,7 @@ class PublishConfig:
     multicast_port: int = DEFAULT_PORT
     multicast_ttl: int = 1
     multicast_interface: str = "127.0.0.1"
+    zenoh: ZenohConfig = ZenohConfig()
 
 
 @frozen
@@ -167,6 +180,14 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "multicast_port": ck.number(1, 65535, integer=True),
             "multicast_ttl": ck.number(0, 255, integer=True),
             "multicast_interface": ck.string,
+            "zenoh": ck.Section(ZenohConfig, {
+                "enabled": ck.boolean,
+                "mode": ck.choice("peer", "client"),
+                "connect": ck.endpoints,
+                "listen": ck.endpoints,
+                "scouting_multicast": ck.boolean,
+                "key": ck.key_template,
+            }),
         },
     ),
     "daemon": (

@@ -21,13 +21,16 @@ import logging
 import signal
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Callable, Dict, Optional
+from typing import TYPE_CHECKING, Any, Callable, Dict, Optional, Protocol
+
+import numpy as np
 
 from .. import _signals
 from ..config import Config
 from ..core.pipeline import Pipeline
 from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
 from ..net.fit import encode_fitting
+from ..net.protocol import wire_time_ns
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource
 from ..view.thresholds import Thresholds
@@ -44,6 +47,16 @@ SourceFactory = Callable[[Config, Callable[[float], object]], FrameSource]
 PublisherFactory = Callable[[Config], Publisher]
 Reload = Callable[[], Config]
 Echo = Callable[[bytes], None]
+
+
+class Recorder(Protocol):
+    """Takes what the loop saw and sent without blocking (``recording.background.BackgroundRecorder``)."""
+
+    def add_frame(self, image: np.ndarray, t_ns: int, index: int) -> None: ...
+
+    def add_reading(self, payload: bytes, t_ns: int) -> None: ...
+
+    def close(self) -> None: ...
 
 
 class Daemon:
@@ -69,6 +82,9 @@ class Daemon:
         The live web page (:mod:`rangebearing.view`): offered a frame only while
         a browser watches, at its capped rate; its threshold changes are applied
         between frames.
+    recorder : Recorder, optional
+        Given every frame and the reading sent for it, stamped with the reading's
+        capture time (``run --record``); closed when the loop ends.
     """
 
     def __init__(
@@ -80,6 +96,7 @@ class Daemon:
         reload: Optional[Reload] = None,
         echo: Optional[Echo] = None,
         view: Optional[ViewHub] = None,
+        recorder: Optional[Recorder] = None,
     ) -> None:
         self.cfg = cfg
         self._open_source = open_source
@@ -87,6 +104,7 @@ class Daemon:
         self._reload_config = reload
         self.echo = echo
         self.view = view
+        self.recorder = recorder
         self.stats = LoopStats()
         self.house = Housekeeping(notifier, self.summary, cfg.daemon.status_interval_s)
         self._stop = threading.Event()
@@ -150,6 +168,8 @@ class Daemon:
             self.house.stopping()
             self.guard.close()
             self._publisher.close()
+            if self.recorder is not None:
+                self.recorder.close()
             log.info("stopped: %s", self.summary().line())
 
     def _loop(self) -> int:
@@ -170,7 +190,8 @@ class Daemon:
                 result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
                 t1 = clock()
                 pub = self.cfg.publish
-                payload = encode_fitting(pub.robot_id, seq, _unix_time(frame, t1), result.landmarks, self.stats.fps,
+                t_unix = _unix_time(frame, t1)
+                payload = encode_fitting(pub.robot_id, seq, t_unix, result.landmarks, self.stats.fps,
                                          self.dropped)  # always one packet: the nearest landmarks if not all fit
             except FrameShapeError:
                 raise
@@ -182,6 +203,10 @@ class Daemon:
             stages = {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1}
             self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages)
             self._echo(payload)
+            if self.recorder is not None:
+                t_ns = wire_time_ns(t_unix)  # the reading's own t, to the µs the wire keeps
+                self.recorder.add_frame(frame.image, t_ns, frame.index)
+                self.recorder.add_reading(payload, t_ns)
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
                 self.view.offer(t2, frame.image, frame.name, result, self.cfg.detection, self._view_status())

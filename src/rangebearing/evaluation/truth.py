@@ -218,3 +218,27 @@ def align_truth(
         raise TruthError(f"{source}: {len(unmatched)} of {len(truth)} truth frame(s) match no frame: {shown} "
                          f"(the frames are named like {example}; a video's frames by their 0-based index)")
     return out
+
+
+def key_by_position(truth: Dict[str, List[TruthRow]], frame_times_ns: List[int]) -> Dict[str, List[TruthRow]]:
+    """Truth for an MCAP recording, keyed as replay names its frames: by position in the file.
+
+    A ``frame`` value is either that 0-based position (``12``) or the frame's
+    capture timestamp in integer Unix nanoseconds as stored in the file
+    (``1700000000123456000``: the ``timestamp`` of its ``foxglove.CompressedImage``,
+    also the MCAP log time); a timestamp that matches a frame becomes its position.
+
+    Raises
+    ------
+    TruthError
+        A value is a timestamp (13 digits or more) that matches no frame.
+    """
+    where = {t: i for i, t in enumerate(frame_times_ns)}
+    out: Dict[str, List[TruthRow]] = {}
+    for key, rows in truth.items():
+        if key.isdigit() and len(key) >= 13:
+            if int(key) not in where:
+                raise TruthError(f"truth frame {key}: no frame of the recording has this timestamp (ns)")
+            key = str(where[int(key)])
+        out.setdefault(key, []).extend(TruthRow(key, r.range_m, r.bearing_rad) for r in rows)
+    return out

@@ -159,6 +159,11 @@ class Reading:
                               omitted=self.omitted)
 
 
+def wire_time_ns(t: float) -> int:
+    """``t`` (Unix s) as a reading carries it, to the µs, in integer ns: what MCAP log times use."""
+    return round(round(float(t), T_DIGITS) * 1e6) * 1000
+
+
 # --- encoding ---------------------------------------------------------------
 
 

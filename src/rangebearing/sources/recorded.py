@@ -1,4 +1,4 @@
-"""Recorded frames: a directory of images or a video file, read lazily, paced like a camera."""
+"""Recorded frames: a directory of images, a video or an MCAP file, read lazily, paced like a camera."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import numpy as np
 from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
+from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
 from .pacing import Pacer
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
@@ -62,7 +63,8 @@ def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     """Yield ``(name, image)`` for every recorded frame, decoding one at a time.
 
     A directory yields its images sorted by file name, an unreadable image as
-    ``(name, None)``; a video yields ``(str(i), image)`` for frame ``i``.
+    ``(name, None)``; a video or an MCAP recording yields ``(str(i), image)``
+    for frame ``i``.
 
     Raises
     ------
@@ -74,6 +76,9 @@ def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     if p.is_dir():
         for img_path in list_images(p):
             yield img_path.name, _decode(img_path)
+        return
+    if is_mcap_file(p):
+        yield from iter_mcap(p)
         return
     cap = _open_video(p)
     try:
@@ -93,6 +98,8 @@ def count_recorded(path: PathLike) -> Optional[int]:
     p = _check_path(path)
     if p.is_dir():
         return len(list_images(p))
+    if is_mcap_file(p):
+        return count_mcap(p)
     cap = _open_video(p)
     try:
         n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
@@ -204,7 +211,7 @@ class RecordedSource:
         self._yuv: Dict[str, Yuv420] = {}  # by frame name, when looping
         self._clock = clock
         self._pacer = Pacer(float(fps), clock, sleep) if fps else None
-        self._reader: Union[_ImageDir, _Video, None] = None
+        self._reader: Union[_ImageDir, _Video, McapFrames, None] = None
         self._next = 0
         self._dropped = 0
 
@@ -217,7 +224,10 @@ class RecordedSource:
         if self._reader is not None:
             return
         p = _check_path(self._path)
-        self._reader = _ImageDir(p, cache=self._loop) if p.is_dir() else _Video(p)
+        if p.is_dir():
+            self._reader = _ImageDir(p, cache=self._loop)
+        else:
+            self._reader = McapFrames(p, _END) if is_mcap_file(p) else _Video(p)
         if self._pacer is not None:
             self._pacer.start()
         self._next = 0
@@ -273,7 +283,7 @@ class RecordedSource:
         return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 
     def _fetch(
-        self, reader: Union[_ImageDir, _Video], i: int
+        self, reader: Union[_ImageDir, _Video, McapFrames], i: int
     ) -> Optional[Tuple[int, Optional[np.ndarray]]]:
         for _ in range(2):  # a second try once a video's length has been learned
             length = reader.length

@@ -1,0 +1,149 @@
+"""Read rangebearing MCAP files back: frames for replay, readings, intrinsics.
+
+Records are streamed in file order with the ``mcap`` library's ``StreamReader``,
+so a file cut short (the recorder killed, the disk full) yields everything up
+to its last complete chunk and then stops, setting :attr:`McapRecording.truncated`,
+where an index-based reader would refuse a file without a footer.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from typing import Any, Iterable, Iterator, List, Optional, Tuple, Union
+
+import cv2
+import numpy as np
+
+from .._compat import frozen
+from ..core.types import CameraIntrinsics
+from ..errors import MissingExtraError, RecordingError
+from .mcap_format import (
+    CALIBRATION_TOPIC,
+    IMAGE_TOPIC,
+    READINGS_TOPIC,
+    ImageMessage,
+    parse_calibration,
+    parse_image,
+)
+
+PathLike = Union[str, "os.PathLike[str]"]
+MAGIC = b"\x89MCAP0\r\n"
+
+
+def is_mcap(path: PathLike) -> bool:
+    """True when ``path`` is a file starting with the MCAP magic bytes (or named ``*.mcap``)."""
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        return p.lower().endswith(".mcap")
+    try:
+        with open(p, "rb") as f:
+            return f.read(len(MAGIC)) == MAGIC
+    except OSError:
+        return False
+
+
+@frozen
+class RecordedMessage:
+    """One message as stored: its topic, log time (Unix ns), sequence and raw bytes."""
+
+    topic: str
+    log_time_ns: int
+    sequence: int
+    data: bytes
+
+
+@frozen
+class RecordedFrame:
+    """One frame from ``/camera/image``: position in the file, source index, capture time, pixels.
+
+    ``image`` is H×W×3 uint8 BGR, or ``None`` when the stored bytes do not decode.
+    """
+
+    position: int
+    index: int
+    t_ns: int
+    image: Optional[np.ndarray]
+
+
+def _stream_reader(f: Any) -> Any:
+    try:
+        from mcap.exceptions import McapError
+        from mcap.records import Channel, Message
+        from mcap.stream_reader import StreamReader
+    except ImportError:
+        raise MissingExtraError("mcap", "mcap", "MCAP recordings") from None
+    return StreamReader(f), McapError, Channel, Message
+
+
+def decode_image(img: ImageMessage) -> Optional[np.ndarray]:
+    """The stored PNG/JPEG as H×W×3 uint8 BGR, or ``None`` when it does not decode."""
+    return cv2.imdecode(np.frombuffer(img.data, np.uint8), cv2.IMREAD_COLOR)
+
+
+class McapRecording:
+    """A recording on disk; every iteration reads the file afresh from the start."""
+
+    def __init__(self, path: PathLike) -> None:
+        self.path = os.fspath(path)
+        self.truncated = False
+        try:
+            with open(self.path, "rb") as f:
+                magic = f.read(len(MAGIC))
+        except OSError as exc:
+            raise RecordingError(f"{self.path}: cannot read: {exc.strerror or exc}") from None
+        if magic != MAGIC:
+            raise RecordingError(f"{self.path}: not an MCAP file (no MCAP magic)")
+
+    def messages(self, topics: Optional[Iterable[str]] = None) -> Iterator[RecordedMessage]:
+        """Every message on ``topics`` (all when None), in file order, up to the last complete chunk."""
+        wanted = None if topics is None else set(topics)
+        self.truncated = False
+        with open(self.path, "rb") as f:
+            reader, mcap_error, channel_type, message_type = _stream_reader(f)
+            channels = {}
+            records = reader.records
+            while True:
+                try:
+                    record = next(records)
+                except StopIteration:
+                    return
+                except (mcap_error, struct.error, ValueError, EOFError, MemoryError):
+                    self.truncated = True  # the rest of the file is cut short or damaged
+                    return
+                if isinstance(record, channel_type):
+                    channels[record.id] = record.topic
+                elif isinstance(record, message_type):
+                    topic = channels.get(record.channel_id)
+                    if topic is not None and (wanted is None or topic in wanted):
+                        yield RecordedMessage(topic, record.log_time, record.sequence, bytes(record.data))
+
+    def images(self) -> Iterator[Tuple[int, int, Optional[ImageMessage]]]:
+        """``(position, source index, image message)`` per frame, not decoded (``None``: not an image)."""
+        for pos, msg in enumerate(self.messages([IMAGE_TOPIC])):
+            try:
+                yield pos, msg.sequence, parse_image(msg.data)
+            except RecordingError:
+                yield pos, msg.sequence, None
+
+    def frames(self, decode: bool = True) -> Iterator[RecordedFrame]:
+        """The frames in file order; ``decode=False`` leaves ``image`` None (timestamps only)."""
+        for pos, index, img in self.images():
+            if img is None:
+                yield RecordedFrame(pos, index, 0, None)
+                continue
+            yield RecordedFrame(pos, index, img.t_ns, decode_image(img) if decode else None)
+
+    def frame_times_ns(self) -> List[int]:
+        """The capture time of every frame, by position in the file."""
+        return [f.t_ns for f in self.frames(decode=False)]
+
+    def readings(self) -> Iterator[RecordedMessage]:
+        """The v1 readings exactly as published (decode them with ``net.decode_reading``)."""
+        return self.messages([READINGS_TOPIC])
+
+    def calibration(self) -> Optional[CameraIntrinsics]:
+        """The first ``/camera/calibration`` message's intrinsics, or ``None``."""
+        for msg in self.messages([CALIBRATION_TOPIC]):
+            return parse_calibration(msg.data)
+        return None
