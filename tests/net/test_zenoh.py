@@ -194,3 +194,20 @@ def test_a_process_that_never_closes_its_subscriber_still_exits(port: int) -> No
             assert child.wait(timeout=10) == 0  # no hang joining Zenoh's callback threads
     finally:
         child.kill()
+
+
+def test_clients_meet_through_a_router(port: int) -> None:
+    """The zenohd layout: robots and controller in client mode, a router in between (here zenoh's own, in-process)."""
+    router_cfg = zenoh.Config.from_json5(json.dumps({
+        "mode": "router", "listen": {"endpoints": [f"tcp/127.0.0.1:{port}"]},
+        "scouting": {"multicast": {"enabled": False}}}))
+    client = ZenohSettings(mode="client", connect=(f"tcp/127.0.0.1:{port}",), scouting_multicast=False)
+    router = zenoh.open(router_cfg)
+    try:
+        with ZenohSubscriber(settings=client) as sub, ZenohPublisher("zumo4", client) as pub:
+            assert first_reading(pub, sub, "zumo4").robot == "zumo4"
+            wait_presence(sub, "zumo4", alive=True)  # liveliness goes through the router too
+            pub.close()
+            wait_presence(sub, "zumo4", alive=False)
+    finally:
+        router.close()

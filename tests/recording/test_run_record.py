@@ -22,8 +22,8 @@ from tests.conftest import STATIC_SCENE
 RUN = [sys.executable, "-m", "rangebearing.cli.main", "run"]
 
 
-def run_config(clip: Path, port: int, loop: bool) -> str:
-    return (f'source: {{kind: recorded, path: "{clip}", fps: 30, loop: {str(loop).lower()}}}\n'
+def run_config(clip: Path, port: int, loop: bool, fps: float = 30) -> str:
+    return (f'source: {{kind: recorded, path: "{clip}", fps: {fps}, loop: {str(loop).lower()}}}\n'
             f'publish: {{robot_id: rec1, unicast: ["127.0.0.1:{port}"]}}\n')
 
 
@@ -39,6 +39,9 @@ def test_kill_9_mid_recording_still_replays_every_complete_chunk(static_clip: Pa
         proc = subprocess.Popen([*RUN, "--config", str(cfg), "--record", str(out), "--record-format", "png"],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         try:
+            first = sub.recv_datagram(30)  # the daemon is up
+            assert first is not None, "the daemon published nothing"
+            sent[first[0].seq] = first[1]
             t_end = time.monotonic() + 2.5  # the writer finishes a chunk at least every second
             while time.monotonic() < t_end:
                 got = sub.recv_datagram(5)
@@ -69,7 +72,7 @@ def test_replay_mcap_with_truth_keyed_by_timestamp(static_clip: Path, tmp_path: 
                                                    capsys: pytest.CaptureFixture) -> None:
     cfg, out = tmp_path / "c.yaml", tmp_path / "run.mcap"
     with Subscriber(port=0) as sub:
-        cfg.write_text(run_config(static_clip, sub.port, loop=False))
+        cfg.write_text(run_config(static_clip, sub.port, loop=False, fps=0))  # every frame, none skipped
         done = subprocess.run([*RUN, "--config", str(cfg), "--record", str(out)], capture_output=True, text=True,
                               timeout=60)
     assert done.returncode == 0, done.stderr
