@@ -21,21 +21,19 @@ import logging
 import signal
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Callable, Dict, Optional, Protocol
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Callable, Dict, Optional
 
 from .. import _signals
 from ..config import Config
 from ..core.pipeline import Pipeline
 from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
 from ..net.fit import encode_fitting
-from ..net.protocol import wire_time_ns
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource
 from ..view.thresholds import Thresholds
 from .capture import CameraGone, CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
+from .recorder import NoRecorder, Recorder
 from .stats import LoopStats, Summary
 
 if TYPE_CHECKING:
@@ -47,16 +45,6 @@ SourceFactory = Callable[[Config, Callable[[float], object]], FrameSource]
 PublisherFactory = Callable[[Config], Publisher]
 Reload = Callable[[], Config]
 Echo = Callable[[bytes], None]
-
-
-class Recorder(Protocol):
-    """Takes what the loop saw and sent without blocking (``recording.background.BackgroundRecorder``)."""
-
-    def add_frame(self, image: np.ndarray, t_ns: int, index: int) -> None: ...
-
-    def add_reading(self, payload: bytes, t_ns: int) -> None: ...
-
-    def close(self) -> None: ...
 
 
 class Daemon:
@@ -83,8 +71,7 @@ class Daemon:
         a browser watches, at its capped rate; its threshold changes are applied
         between frames.
     recorder : Recorder, optional
-        Given every frame and the reading sent for it, stamped with the reading's
-        capture time (``run --record``); closed when the loop ends.
+        Given every frame with the reading sent for it (``run --record``); closed when the loop ends.
     """
 
     def __init__(
@@ -104,7 +91,7 @@ class Daemon:
         self._reload_config = reload
         self.echo = echo
         self.view = view
-        self.recorder = recorder
+        self.recorder = recorder or NoRecorder()
         self.stats = LoopStats()
         self.house = Housekeeping(notifier, self.summary, cfg.daemon.status_interval_s)
         self._stop = threading.Event()
@@ -168,8 +155,7 @@ class Daemon:
             self.house.stopping()
             self.guard.close()
             self._publisher.close()
-            if self.recorder is not None:
-                self.recorder.close()
+            self.recorder.close()
             log.info("stopped: %s", self.summary().line())
 
     def _loop(self) -> int:
@@ -203,10 +189,7 @@ class Daemon:
             stages = {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1}
             self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages)
             self._echo(payload)
-            if self.recorder is not None:
-                t_ns = wire_time_ns(t_unix)  # the reading's own t, to the µs the wire keeps
-                self.recorder.add_frame(frame.image, t_ns, frame.index)
-                self.recorder.add_reading(payload, t_ns)
+            self.recorder.add(frame.image, frame.index, payload, t_unix)
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
                 self.view.offer(t2, frame.image, frame.name, result, self.cfg.detection, self._view_status())

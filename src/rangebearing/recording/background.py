@@ -24,6 +24,7 @@ import numpy as np
 
 from ..core.types import CameraIntrinsics
 from ..errors import FrameError, RecordingError
+from ..net.protocol import wire_time_ns
 from .mcap_format import image_message
 from .mcap_writer import McapRecorder, encode_image, import_mcap_writer
 
@@ -80,6 +81,12 @@ class BackgroundRecorder:
         self._thread.start()
 
     # --- the capture loop's side: never blocks, never raises ---------------
+
+    def add(self, image: np.ndarray, index: int, payload: bytes, t_s: float) -> None:
+        """Queue a frame and the reading sent for it, both stamped with the reading's ``t`` (to the µs)."""
+        t_ns = wire_time_ns(t_s)
+        self.add_frame(image, t_ns, index)
+        self.add_reading(payload, t_ns)
 
     def add_frame(self, image: np.ndarray, t_ns: int, index: int) -> None:
         """Queue one frame (the array is not copied: sources hand out a fresh one per frame)."""

@@ -224,10 +224,8 @@ class RecordedSource:
         if self._reader is not None:
             return
         p = _check_path(self._path)
-        if p.is_dir():
-            self._reader = _ImageDir(p, cache=self._loop)
-        else:
-            self._reader = McapFrames(p, _END) if is_mcap_file(p) else _Video(p)
+        files = McapFrames(p, _END) if not p.is_dir() and is_mcap_file(p) else None
+        self._reader = _ImageDir(p, cache=self._loop) if p.is_dir() else files or _Video(p)
         if self._pacer is not None:
             self._pacer.start()
         self._next = 0
