@@ -105,7 +105,7 @@ def imported_modules(*argv: str) -> List[str]:
     """
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
     code = ("import sys; from rangebearing.cli.main import main; code = main(sys.argv[1:]); "
-            "print(*sorted(m for m in sys.modules if m.startswith('rangebearing'))); sys.exit(code)")
+            "print(*sorted(m for m in sys.modules if m.startswith(('rangebearing', 'http')))); sys.exit(code)")
     proc = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, env=env, cwd=REPO,
                           timeout=60)
     assert proc.returncode == 0, proc.stderr[-2000:]
@@ -115,7 +115,9 @@ def imported_modules(*argv: str) -> List[str]:
 def test_run_check_loads_only_what_the_daemon_needs() -> None:
     mods = imported_modules("run", "--config", "config/demo.yaml", "--check")
     assert "rangebearing.daemon.loop" in mods and "rangebearing.cli.run_cmd" in mods  # the measurement works
-    unwanted = [m for m in mods if m.startswith(("rangebearing.synth", "rangebearing.evaluation"))
+    not_needed = ("rangebearing.synth", "rangebearing.evaluation", "rangebearing.recording")
+    http_server = ("rangebearing.view.server", "rangebearing.view.handler", "rangebearing.view.hub", "http.server")
+    unwanted = [m for m in mods if m.startswith(not_needed) or m in http_server
                 or m == "rangebearing.core.fit" or (m.startswith("rangebearing.cli.") and m.endswith("_cmd")
                                                     and m != "rangebearing.cli.run_cmd")]
     assert unwanted == []

@@ -6,8 +6,19 @@ watches, at a capped rate) and encodes them on its own thread;
 the standard library's ``ThreadingHTTPServer``. See ``docs/view.md``.
 """
 
-from .hub import Snapshot, ViewHub
-from .server import ViewServer
-from .thresholds import Thresholds
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+# Loaded on first use: the daemon imports view.thresholds on every start, and must not pay for the
+# HTTP server (http.server, email, …) unless daemon.view_port asks for it.
+_LAZY = {"Snapshot": ".hub", "ViewHub": ".hub", "ViewServer": ".server", "Thresholds": ".thresholds"}
 
 __all__ = ["Snapshot", "Thresholds", "ViewHub", "ViewServer"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
