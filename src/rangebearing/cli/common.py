@@ -8,10 +8,8 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import os
 import shutil
 import sys
-import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
 
@@ -19,6 +17,7 @@ from ..config import Config, SourceConfig, dump_config, load_config
 from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
 from ..net.zenoh_transport import ZenohSettings
+from .outputs import write_bytes_atomic
 
 if TYPE_CHECKING:
     from ..evaluation.truth import TruthRow
@@ -71,22 +70,13 @@ def write_atomic(path: Union[str, Path], text: str) -> Optional[Path]:
     """
     out = Path(path)
     backup = None
-    try:
-        if out.exists():
-            backup = out.with_name(out.name + ".bak")
-            shutil.copy2(out, backup)
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent or ".")
+    if out.exists():
+        backup = out.with_name(out.name + ".bak")
         try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, out)
-        except BaseException:
-            os.unlink(tmp)
-            raise
-    except OSError as exc:
-        raise OutputError(f"cannot write {out}: {exc.strerror or exc}") from None
+            shutil.copy2(out, backup)
+        except OSError as exc:
+            raise OutputError(f"cannot keep {out} as {backup}: {exc.strerror or exc}") from None
+    write_bytes_atomic(out, text.encode("utf-8"), durable=True)
     return backup
 
 

@@ -73,14 +73,20 @@ def check_output_dir(path: PathLike, flag: str, inputs: Iterable[Optional[PathLi
     return out
 
 
-def write_bytes_atomic(path: PathLike, data: bytes) -> None:
-    """``data`` into ``path`` through a temporary file and one rename."""
+def write_bytes_atomic(path: PathLike, data: bytes, durable: bool = False) -> None:
+    """``data`` into ``path`` through a temporary file and one rename (``durable``: fsync before the rename).
+
+    A crash leaves the old file or the new one, never half of one.
+    """
     out = Path(path)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", dir=out.parent)
         try:
             with os.fdopen(fd, "wb") as f:
                 f.write(data)
+                if durable:
+                    f.flush()
+                    os.fsync(f.fileno())
             os.replace(tmp, out)
         except BaseException:
             os.unlink(tmp)

@@ -30,7 +30,33 @@ def _ipv4(value: str, what: str) -> bytes:
         raise SubscribeError(f"{what}: {value!r} is not an IPv4 address or host: {exc}") from None
 
 
-class Subscriber:
+class ReadingStream:
+    """What every subscriber offers on top of its own ``recv_datagram``: readings one by one, or as an iterator.
+
+    Subclasses implement ``recv_datagram(timeout_s) -> (Reading, bytes) | None``.
+    """
+
+    def recv_datagram(self, timeout_s: Optional[float] = None) -> Optional[Tuple[Reading, bytes]]:
+        raise NotImplementedError
+
+    def recv(self, timeout_s: Optional[float] = None) -> Optional[Reading]:
+        """The next valid reading, or ``None`` if none arrives within the timeout."""
+        got = self.recv_datagram(timeout_s)
+        return None if got is None else got[0]
+
+    def readings(self, timeout_s: Optional[float] = None) -> Iterator[Reading]:
+        """Yield readings until one takes longer than the timeout to arrive."""
+        while True:
+            reading = self.recv(timeout_s)
+            if reading is None:
+                return
+            yield reading
+
+    def __iter__(self) -> Iterator[Reading]:
+        return self.readings()
+
+
+class Subscriber(ReadingStream):
     """A UDP socket bound for readings, unicast or multicast.
 
     Parameters
@@ -124,22 +150,6 @@ class Subscriber:
                 continue
             self.received += 1
             return reading, data
-
-    def recv(self, timeout_s: Optional[float] = None) -> Optional[Reading]:
-        """The next valid reading, or ``None`` if none arrives within the timeout."""
-        got = self.recv_datagram(timeout_s)
-        return None if got is None else got[0]
-
-    def readings(self, timeout_s: Optional[float] = None) -> Iterator[Reading]:
-        """Yield readings until one takes longer than the timeout to arrive."""
-        while True:
-            reading = self.recv(timeout_s)
-            if reading is None:
-                return
-            yield reading
-
-    def __iter__(self) -> Iterator[Reading]:
-        return self.readings()
 
     def close(self) -> None:
         """Leave the group (if any) and close the socket."""

@@ -18,10 +18,11 @@ import queue
 import threading
 import time
 import weakref
-from typing import Any, Iterator, Optional, Set, Tuple
+from typing import Any, Optional, Set, Tuple
 
 from .._compat import frozen
 from ..errors import ConfigError, ProtocolError
+from .client import ReadingStream
 from .protocol import Reading, decode_reading
 from .zenoh_transport import ZenohSettings, import_zenoh, open_session, presence_key
 
@@ -58,7 +59,7 @@ def _robot_of(key: str) -> str:
     return parts[-2] if len(parts) >= 2 else key
 
 
-class ZenohSubscriber:
+class ZenohSubscriber(ReadingStream):
     """Subscribes to readings (and presence) on a Zenoh key expression.
 
     Parameters
@@ -156,22 +157,6 @@ class ZenohSubscriber:
                 continue
             self.received += 1
             return reading, data
-
-    def recv(self, timeout_s: Optional[float] = None) -> Optional[Reading]:
-        """The next valid reading, or ``None`` if none arrives within the timeout."""
-        got = self.recv_datagram(timeout_s)
-        return None if got is None else got[0]
-
-    def readings(self, timeout_s: Optional[float] = None) -> Iterator[Reading]:
-        """Yield readings until one takes longer than the timeout to arrive."""
-        while True:
-            reading = self.recv(timeout_s)
-            if reading is None:
-                return
-            yield reading
-
-    def __iter__(self) -> Iterator[Reading]:
-        return self.readings()
 
     def close(self) -> None:
         """Undeclare the subscribers and close the session. Safe to call twice."""
