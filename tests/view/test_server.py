@@ -5,6 +5,7 @@ from __future__ import annotations
 import http.client
 import json
 import shutil
+import time
 from pathlib import Path
 from typing import Any, Dict, Iterator, Optional, Tuple
 
@@ -123,10 +124,12 @@ def test_thresholds_change_detection_live(served) -> None:
     srv, feeder, _ = served
     status, body = post_json(srv, "/api/thresholds", {"s_min": 255})
     assert status == 200 and body["thresholds"]["s_min"] == 255
-    for _ in range(50):  # the loop rebuilds its pipeline between frames
+    deadline = time.monotonic() + 10.0  # the loop rebuilds its pipeline between frames: poll until it has
+    while True:
         state = json.loads(request(srv, "GET", "/api/state")[2])
-        if state["thresholds"]["s_min"] == 255:
+        if (state["thresholds"]["s_min"] == 255 and state["landmarks"] == []) or time.monotonic() > deadline:
             break
+        time.sleep(0.01)
     assert state["thresholds"]["s_min"] == 255 and state["landmarks"] == []
     assert feeder.cfg.detection.s_min == 255
 
