@@ -11,7 +11,7 @@ import math
 import shutil
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
+from typing import TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
 
 from ..config import Config, SourceConfig, dump_config, load_config
 from ..errors import ConfigError, OutputError
@@ -246,3 +246,18 @@ def settings_from_args(args: argparse.Namespace, default_listen: Optional[str]) 
     listen = tuple(args.listen) or ((default_listen,) if quiet else ())
     return ZenohSettings(mode=args.mode, connect=tuple(args.connect), listen=listen,
                          scouting_multicast=bool(args.scout))
+
+
+def positive(kind: type, unit: str = "") -> Any:
+    """An argparse ``type``: a finite number of ``kind`` above 0 (``unit`` names it in the message)."""
+
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a {unit or kind.__name__}") from None
+        if not value > 0 or (isinstance(value, float) and not math.isfinite(value)):
+            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+        return value
+
+    return parse

@@ -5,14 +5,13 @@ from __future__ import annotations
 import argparse
 import io
 import json
-import math
 import sys
 from typing import Any, Optional, TextIO
 
 from ..config import DEFAULT_PORT
 from ..errors import ConfigError, NoReadingError, SubscribeError
 from ..net.client import Subscriber
-from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, format_reading, settings_from_args
+from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, format_reading, positive, settings_from_args
 
 DESCRIPTION = """\
 Listen for rangebearing readings and print one line per frame:
@@ -39,19 +38,6 @@ def _port(text: str) -> int:
     return port
 
 
-def _positive(kind: type) -> Any:
-    def parse(text: str) -> Any:
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a {kind.__name__}") from None
-        if not value > 0 or (isinstance(value, float) and not math.isfinite(value)):
-            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-        return value
-
-    return parse
-
-
 def register(subparsers: Any) -> None:
     """Add the ``listen`` subcommand to a ``parser.add_subparsers()`` object."""
     p = subparsers.add_parser(
@@ -73,10 +59,10 @@ def register(subparsers: Any) -> None:
         "--interface", default=None, metavar="I", help="address of the interface to join --group on (default 127.0.0.1)"
     )
     p.add_argument("--json", action="store_true", help="print each datagram's raw JSON instead")
-    p.add_argument("--count", type=_positive(int), default=None, metavar="N", help="exit 0 after N readings")
+    p.add_argument("--count", type=positive(int), default=None, metavar="N", help="exit 0 after N readings")
     p.add_argument(
         "--timeout",
-        type=_positive(float),
+        type=positive(float),
         default=None,
         metavar="S",
         help="exit 1 if no reading arrives for S seconds (default: wait forever)",

@@ -18,7 +18,7 @@ from ..net.protocol import decode_reading
 from ..net.publisher import Publisher, UdpPublisher
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
-from .common import add_config_arg, add_source_args, config_from_args, format_reading, source_from_args
+from .common import add_config_arg, add_source_args, config_from_args, format_reading, positive, source_from_args
 
 if TYPE_CHECKING:
     from ..view.server import ViewServer
@@ -42,7 +42,7 @@ def register(sub: Any) -> None:
     p.add_argument("--record", metavar="FILE.mcap", default=None,
                    help="also record every frame and reading into an MCAP file (needs the mcap extra; "
                         "a writer thread, never slowing or stopping the loop)")
-    p.add_argument("--record-max-mb", type=_megabytes, default=None, metavar="N",
+    p.add_argument("--record-max-mb", type=positive(float, "number of megabytes"), default=None, metavar="N",
                    help="rotate at N MB: the full file becomes FILE.1.mcap (replacing the previous one), "
                         "so at most ~2N MB of the latest frames are kept (default: no limit)")
     p.add_argument("--record-format", choices=("jpeg", "png"), default="jpeg",
@@ -50,14 +50,7 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _megabytes(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of megabytes") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-    return value
+
 
 
 def recorder_for(args: argparse.Namespace, cfg: Config) -> Optional[Any]:

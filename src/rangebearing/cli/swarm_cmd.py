@@ -9,7 +9,7 @@ from typing import Any, Callable, Optional, TextIO, Union
 
 from ..errors import TransportError
 from ..net.swarm import SwarmState, render
-from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, settings_from_args
+from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, positive, settings_from_args
 
 DESCRIPTION = """\
 Show the whole swarm at a glance: one line per robot with its state (alive,
@@ -31,14 +31,7 @@ DEFAULT_LISTEN = DEFAULT_ZENOH_LISTEN
 CLEAR = "\x1b[H\x1b[2J"
 
 
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number of seconds") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-    return value
+
 
 
 def register(subparsers: Any) -> None:
@@ -49,9 +42,10 @@ def register(subparsers: Any) -> None:
     p.add_argument("--udp", action="store_true", help="hear plain UDP readings instead of Zenoh")
     p.add_argument("--port", type=int, default=None, help="UDP port with --udp (default 47800)")
     p.add_argument("--host", default="127.0.0.1", help="UDP address to bind with --udp (default 127.0.0.1)")
-    p.add_argument("--interval", type=_seconds, default=None, metavar="S",
+    seconds = positive(float, "number of seconds")
+    p.add_argument("--interval", type=seconds, default=None, metavar="S",
                    help="refresh every S seconds (default 0.5 on a terminal, 5 when piped)")
-    p.add_argument("--duration", type=_seconds, default=None, metavar="S", help="exit 0 after S seconds")
+    p.add_argument("--duration", type=seconds, default=None, metavar="S", help="exit 0 after S seconds")
     p.set_defaults(func=run)
 
 
