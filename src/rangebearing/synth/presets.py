@@ -21,6 +21,9 @@ an auto-exposed Bayer camera:
                backlit light.
 ``crowd-moving`` 4–6 robots driving and crossing at 30 fps, each with its
                ``robot_id`` (see :mod:`.motion`).
+
+The photoreal presets (:mod:`.photoreal`) put those scenes through the Pi
+Camera v1's lens and ISP and richer rooms: ``photoreal``, ``photoreal-crowd``.
 """
 
 from __future__ import annotations
@@ -40,12 +43,13 @@ from .camera import landmark_bbox_px
 from .clutter import clutter_scene
 from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
 from .motion import crowd_sequence
+from .photoreal import PHOTOREAL_HELP, PHOTOREAL_PRESETS, photoreal_scene, photoreal_sequence
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
 from .touching import touching_scene
 
 ORIGINAL_PRESETS = ("paper", "wide", "clutter", "multi", "sample")
 CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving")
-PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS
+PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS
 SAMPLE_FPS = 30.0
 PRESET_HELP = {
     "paper": "one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg",
@@ -61,6 +65,7 @@ PRESET_HELP = {
     "lighting": "1-3 robots under dim, bright, warm, cool, coloured, spotlit or backlit light",
     "crowd-moving": "4-6 robots driving about and crossing each other at 30 fps; truth.csv's "
                     "robot column keeps each robot's identity",
+    **PHOTOREAL_HELP,
 }
 
 
@@ -201,6 +206,8 @@ def random_scene(rng: np.random.Generator, preset: str,
         return _NEWER[preset](rng, camera)
     if preset == "crowd-moving":
         return next(crowd_sequence(rng, 1, camera))
+    if preset in PHOTOREAL_PRESETS:
+        return photoreal_scene(rng, preset, camera)
     raise SceneError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
 
 
@@ -210,6 +217,9 @@ def scene_sequence(rng: np.random.Generator, preset: str, frames: int,
     ``sample`` and ``crowd-moving``."""
     if preset == "crowd-moving":
         yield from crowd_sequence(rng, frames, camera)
+        return
+    if preset in PHOTOREAL_PRESETS:
+        yield from photoreal_sequence(rng, preset, frames, camera)
         return
     if preset != "sample":
         for _ in range(frames):

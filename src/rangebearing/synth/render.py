@@ -82,6 +82,11 @@ def _edges(ident: np.ndarray) -> np.ndarray:
 
 
 def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
+    """Anti-aliased linear radiance of a scene, before the sensor (see :func:`render_layers`)."""
+    return render_layers(scene, supersample)[0]
+
+
+def render_layers(scene: Scene, supersample: int = 4) -> Tuple[np.ndarray, np.ndarray]:
     """Anti-aliased linear radiance of a scene, before the sensor.
 
     Parameters
@@ -93,10 +98,12 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
 
     Returns
     -------
-    numpy.ndarray
+    radiance : numpy.ndarray
         (H, W, 3) float64 linear RGB radiance (reflectance × shading, not yet
         exposed), H and W from ``scene.camera``. Pixels whose ray the
         distortion model cannot invert are black.
+    depth_m : numpy.ndarray
+        (H, W) depth (Z) of what each pixel centre's ray hits (inf: nothing).
     """
     cam, h = scene.camera, scene.camera_height_m
     grid = ray_grid(cam)
@@ -115,8 +122,9 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
     hits.ident[nan] = -1
     out = hits.rad
     out[nan] = 0.0
+    depth = hits.t
     if supersample <= 1:
-        return out
+        return out, depth
     flag = _edges(hits.ident)
     near_landmark = np.zeros_like(flag)
     for prim, rect in zip(prims, rects):
@@ -133,7 +141,7 @@ def render_linear(scene: Scene, supersample: int = 4) -> np.ndarray:
         _resample(out, np.nonzero(flag & ~near_landmark), coarse, scene, shade, prims, rects)
         flag = fine
     _resample(out, np.nonzero(flag), supersample, scene, shade, prims, rects)
-    return out
+    return out, depth
 
 
 def _resample(out: np.ndarray, at: Tuple[np.ndarray, np.ndarray], n: int, scene: Scene,
@@ -165,16 +173,18 @@ def _gamma_lut(gamma: float) -> np.ndarray:
     return np.round(255.0 * x**gamma).astype(np.uint8)
 
 
-def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator]) -> np.ndarray:
+def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator],
+            depth_m: Optional[np.ndarray] = None) -> np.ndarray:
     """Linear radiance to what the camera delivers: BGR uint8 (H, W, 3).
 
     Blur (optical, linear light) → exposure × white-balance gains → shot and
     read noise (only with an ``rng``) → clip to [0, 1] → gamma → 8 bits.
-    With auto exposure, a Bayer mosaic, glare or vignetting, :func:`.sensor.develop_sensor`.
+    With auto exposure, a Bayer mosaic, glare, vignetting or any lens or ISP
+    stage, :func:`.sensor.develop_sensor` (defocus needs ``depth_m``).
     """
     im, li = scene.imaging, scene.lighting
-    if im.auto_exposure or im.bayer or im.glare > 0 or im.vignetting > 0:
-        return develop_sensor(linear, scene, rng, _gamma_lut(float(im.gamma)))
+    if im.auto_exposure or im.bayer or im.glare > 0 or im.vignetting > 0 or im.isp:
+        return develop_sensor(linear, scene, rng, _gamma_lut(float(im.gamma)), depth_m)
     img = linear.astype(np.float32)
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
@@ -208,4 +218,5 @@ def render(scene: Scene, rng: Optional[np.random.Generator] = None, *,
     numpy.ndarray
         (H, W, 3) uint8 in OpenCV's BGR order.
     """
-    return develop(render_linear(scene, supersample), scene, rng)
+    linear, depth = render_layers(scene, supersample)
+    return develop(linear, scene, rng, depth)

@@ -14,6 +14,7 @@ from typing import Optional, Tuple
 from .._compat import frozen
 from ..core.types import CameraIntrinsics, LandmarkGeometry
 from ..errors import SceneError
+from .imaging import Imaging, imaging_problems
 
 RGB = Tuple[float, float, float]
 
@@ -188,35 +189,6 @@ class Lighting:
 
 
 @frozen
-class Imaging:
-    """The sensor and lens: blur, noise (in linear units of full scale) and gamma.
-
-    ``auto_exposure``: the exposure is set from the scene's metered brightness
-    (centre-weighted mean luminance brought to ``ae_target``, times
-    ``ae_error`` for a loop not quite settled, within ``ae_limits``), and noise
-    grows with the gain it needs. ``bayer``: noise is drawn per photosite of an
-    RGGB mosaic that is then demosaiced (colour fringes at band edges).
-    ``glare``: the fraction of light scattered into a wide halo (veiling glare
-    from a bright window). ``edge_supersample`` > 0: edges away from every
-    landmark get that many rays squared instead of the renderer's full count.
-    ``vignetting``: the fraction of light lost in the image corners (cos⁴-like).
-    """
-
-    blur_sigma_px: float = 0.0
-    read_noise: float = 0.0
-    shot_noise: float = 0.0
-    gamma: float = 1.0 / 2.2
-    auto_exposure: bool = False
-    ae_target: float = 0.18
-    ae_error: float = 1.0
-    ae_limits: Tuple[float, float] = (0.01, 16.0)
-    bayer: bool = False
-    glare: float = 0.0
-    edge_supersample: int = 0
-    vignetting: float = 0.0
-
-
-@frozen
 class Scene:
     """Everything one frame shows. ``wall_distance_m=None`` is an open room.
 
@@ -263,5 +235,6 @@ class Scene:
             for i, obj in enumerate(getattr(self, name)):
                 if not obj.top_m > obj.bottom_m:
                     problems.append(f"{name}[{i}]: top_m must be above bottom_m")
+        problems += imaging_problems(self.imaging)
         if problems:
             raise SceneError(problems, "synthetic scene")

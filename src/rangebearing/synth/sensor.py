@@ -18,6 +18,7 @@ from typing import Optional
 import cv2
 import numpy as np
 
+from . import isp, optics
 from .scene import Scene
 
 NOMINAL_EXPOSURE = 1.25  # the exposure at unity gain (what the original presets use)
@@ -71,10 +72,14 @@ def _mosaic(raw: np.ndarray) -> np.ndarray:
 
 
 def develop_sensor(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator],
-                   lut: np.ndarray) -> np.ndarray:
-    """Linear radiance to BGR uint8 through the camera described above."""
+                   lut: np.ndarray, depth_m: Optional[np.ndarray] = None) -> np.ndarray:
+    """Linear radiance to BGR uint8 through the camera described above (and, when
+    ``scene.imaging.isp``, the lens of :mod:`.optics` and the ISP of :mod:`.isp`;
+    defocus needs the per-pixel ``depth_m``)."""
     im, li = scene.imaging, scene.lighting
     img = linear.astype(np.float32)
+    if im.focus_m > 0 and depth_m is not None:
+        img = optics.defocus(img, depth_m, im.focus_m, im.aperture_m, scene.camera.fx_px)
     if im.glare > 0:
         h, w = img.shape[:2]
         small = cv2.resize(img, (max(w // 8, 1), max(h // 8, 1)), interpolation=cv2.INTER_AREA)
@@ -83,8 +88,12 @@ def develop_sensor(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Gen
         img = (1.0 - im.glare) * img + np.float32(im.glare) * halo
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
+    if im.isp:
+        img = optics.lateral_colour(optics.soft_corners(img, im.soft_corners_px), im.lateral_colour)
     if im.vignetting > 0:
         img *= _vignette(*img.shape[:2], float(im.vignetting))[..., None]
+    if im.ccm is not None:
+        img = np.maximum(isp.to_sensor(img, im.ccm), 0.0)
     exposure = auto_exposure(img, scene) if im.auto_exposure else li.exposure
     gain = max(exposure / NOMINAL_EXPOSURE, 1.0)
     raw = np.minimum(img * np.float32(exposure), 1.0)  # photosites saturate
@@ -95,11 +104,31 @@ def develop_sensor(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Gen
         raw = raw + np.sqrt(var) * rng.standard_normal(raw.shape, dtype=np.float32)
     codes = np.clip(np.round(raw * RAW_LEVELS), 0, RAW_LEVELS).astype(np.uint16)
     if im.bayer:
-        rgb = cv2.cvtColor(codes * np.uint16(64), cv2.COLOR_BayerBG2RGB_EA).astype(np.float32)
+        code = cv2.COLOR_BayerBG2RGB_EA if im.demosaic == "ea" else cv2.COLOR_BayerBG2RGB
+        rgb = cv2.cvtColor(codes * np.uint16(64), code).astype(np.float32)
         rgb /= np.float32(RAW_LEVELS * 64)
     else:
         rgb = codes.astype(np.float32) / np.float32(RAW_LEVELS)
-    rgb *= np.asarray(li.wb_gains, dtype=np.float32)
+    if not im.isp:
+        rgb *= np.asarray(li.wb_gains, dtype=np.float32)
+        np.clip(rgb, 0.0, 1.0, out=rgb)
+        idx = (rgb * 65535.0 + 0.5).astype(np.uint16)
+        return cv2.cvtColor(np.take(lut, idx), cv2.COLOR_RGB2BGR)
+    return _isp(rgb, scene, lut)
+
+
+def _isp(rgb: np.ndarray, scene: Scene, lut: np.ndarray) -> np.ndarray:
+    """Demosaiced raw (H, W, 3) float32 to BGR uint8: colour matrix, AWB, gamma,
+    colour denoise, sharpening, chroma subsampling, JPEG (each only when the scene asks for it)."""
+    im = scene.imaging
+    if im.ccm is not None:
+        rgb = isp.from_sensor(rgb, im.ccm)
+    gains = isp.awb_gains(rgb, scene.lighting.wb_gains, im.awb_pull)
+    rgb = rgb * np.asarray(gains, dtype=np.float32)
     np.clip(rgb, 0.0, 1.0, out=rgb)
-    idx = (rgb * 65535.0 + 0.5).astype(np.uint16)
-    return cv2.cvtColor(np.take(lut, idx), cv2.COLOR_RGB2BGR)
+    out = np.take(lut, (rgb * 65535.0 + 0.5).astype(np.uint16))
+    out = isp.chroma_denoise(cv2.cvtColor(out, cv2.COLOR_RGB2BGR), im.chroma_denoise_px)
+    out = cv2.cvtColor(isp.sharpen(cv2.cvtColor(out, cv2.COLOR_BGR2RGB), im.sharpen), cv2.COLOR_RGB2BGR)
+    if im.chroma_420 and im.jpeg_quality <= 0:
+        out = isp.subsample_chroma(out)
+    return isp.jpeg(out, im.jpeg_quality) if im.jpeg_quality > 0 else out

@@ -1,0 +1,88 @@
+"""The ``photoreal`` presets: the crowd-proof scenes through a real camera's lens and ISP.
+
+An independent path-traced render of the same situations differs from ours
+in ways no single preset asks about; these presets put all of them together
+(see docs/synth.md, "Photoreal"):
+
+- the Pi Camera v1's fixed-focus lens: defocus by depth (focused 0.8–3 m, so
+  a landmark at 0.15–0.3 m is soft), softer corners, lateral colour;
+- its ISP: the OV5647 colour matrix (chroma noise), an AWB pulled by the
+  frame's colours, edge-aware or bilinear demosaic, colour denoise, luma
+  sharpening (halos),
+  4:2:0 chroma or JPEG.
+
+``photoreal``        one scene of ``far``, ``lighting``, ``occlusion`` or
+                     ``touching`` kind per frame (1–4 robots, 0.15–2 m).
+``photoreal-crowd``  ``crowd`` scenes (5–8 robots).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable, Dict, Iterator
+
+import numpy as np
+
+from ..core.types import CameraIntrinsics
+from . import isp
+from . import sampling as d
+from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
+from .scene import Imaging, Scene
+from .touching import touching_scene
+
+PHOTOREAL_PRESETS = ("photoreal", "photoreal-crowd")
+PHOTOREAL_HELP = {
+    "photoreal": "far/lighting/occlusion/touching scenes through the Pi Camera v1's lens and ISP "
+                 "(defocus, colour matrix, AWB pull, sharpening, 4:2:0/JPEG)",
+    "photoreal-crowd": "crowd scenes (5-8 robots) through the same lens and ISP",
+}
+_KINDS: Dict[str, Callable[[np.random.Generator, CameraIntrinsics], Scene]] = {
+    "far": far_scene, "lighting": lighting_scene, "occlusion": occlusion_scene,
+    "touching": touching_scene}
+
+
+def camera_isp(rng: np.random.Generator, scene: Scene) -> Imaging:
+    """The scene's camera with the lens and ISP stages of the Pi Camera v1 drawn."""
+    im = scene.imaging
+    warm = scene.lighting.colour[2] < 0.8 * scene.lighting.colour[0]
+    cool = scene.lighting.colour[0] < 0.9 * scene.lighting.colour[2]
+    ccm = isp.OV5647_CCMS[0 if warm else 2 if cool else 1]
+    fmt = rng.random()
+    # the colour matrix amplifies raw noise about 1.5x in luma: less of it on the photosites
+    return dataclasses.replace(
+        im, read_noise=im.read_noise / 1.5, shot_noise=im.shot_noise / 2.25,
+        focus_m=d.log_uniform(rng, 0.8, 3.0), aperture_m=0.00124 * d.uniform(rng, 0.9, 1.1),
+        soft_corners_px=d.uniform(rng, 0.2, 1.0), lateral_colour=d.uniform(rng, -1.0, 1.0) * 0.0015,
+        ccm=tuple(float(v) for row in ccm for v in row), awb_pull=d.uniform(rng, 0.15, 0.5),
+        demosaic="ea" if rng.random() < 0.6 else "bilinear",
+        chroma_denoise_px=d.uniform(rng, 1.0, 2.5), sharpen=d.uniform(rng, 0.3, 1.5),
+        chroma_420=fmt < 0.4, jpeg_quality=int(rng.integers(75, 96)) if fmt >= 0.7 else 0)
+
+
+def photoreal_scene(rng: np.random.Generator, preset: str, camera: CameraIntrinsics) -> Scene:
+    """One frame of a photoreal preset (see the module docstring)."""
+    if preset == "photoreal-crowd":
+        scene = crowd_scene(rng, camera)
+    else:
+        kinds = list(_KINDS)
+        scene = _KINDS[kinds[int(rng.integers(len(kinds)))]](rng, camera)
+    return dataclasses.replace(scene, imaging=camera_isp(rng, scene))
+
+
+def photoreal_sequence(rng: np.random.Generator, preset: str, frames: int,
+                       camera: CameraIntrinsics) -> Iterator[Scene]:
+    """``frames`` independent draws of a photoreal preset."""
+    for _ in range(frames):
+        yield photoreal_scene(rng, preset, camera)
+
+
+def defocus_px(scene: Scene, range_m: float) -> float:
+    """Blur-disc diameter (px) the scene's lens gives a point ``range_m`` ahead (0: in focus)."""
+    im = scene.imaging
+    if im.focus_m <= 0:
+        return 0.0
+    return im.aperture_m * scene.camera.fx_px * abs(1.0 / range_m - 1.0 / im.focus_m)
+
+
+__all__ = ["PHOTOREAL_HELP", "PHOTOREAL_PRESETS", "camera_isp", "defocus_px", "photoreal_scene",
+           "photoreal_sequence"]
