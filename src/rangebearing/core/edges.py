@@ -117,11 +117,30 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
     return float(np.std(sums, ddof=1) / np.sqrt(cols))
 
 
-def limb(profile: np.ndarray, core: int, end: int, level: float, bg: float) -> float:
-    """Sub-pixel limb column from a column profile: going right when ``end > core``, else left;
-    NaN when the band does not stand out from what lies beyond (no limb to see)."""
+LIMB_BLUR_PX = 3  # columns a limb's edge may be spread over (optics, sensor, the ½-resolution search)
+
+
+def limb(profile: np.ndarray, core: int, end: int, level: float) -> float:
+    """Sub-pixel limb column from a column profile of a band's chromaticity, going right when
+    ``end > core``, else left; NaN when the band never falls to half its ``level`` (no limb to see).
+
+    The limb is the first fall below half the band's level past ``core``; the two-level
+    integral runs from just inside it to ``LIMB_BLUR_PX`` past it, against the level
+    right beyond it (the median of the next ``BG_ROWS`` columns: past the blur, short
+    of whatever may follow). Whatever lies farther out (a neighbour's band of the same colour,
+    only partly in these rows) does not count: a band beside it can make this band look
+    wider, never narrower.
+    """
+    step = 1 if end > core else -1
+    seg = profile[core : end + 1] if step > 0 else profile[core : (end - 1 if end > 0 else None) : -1]
+    fall = np.flatnonzero(seg < 0.5 * level)
+    if len(fall) == 0 or fall[0] == 0:
+        return float("nan")
+    k = int(fall[0])
+    stop = min(len(seg) - 1, k + LIMB_BLUR_PX)
+    start = max(0, k - LIMB_BLUR_PX - 1)
+    bg = float(np.median(seg[k + 1 : k + 1 + BG_ROWS])) if k + 1 < len(seg) else float(seg[k])
     if not level - bg > MERGE_CONTRAST * abs(level):
         return float("nan")
-    if end > core:
-        return edge_down(profile, core, end, level, bg)
-    return edge_up(profile, core, end, level, bg)
+    edge = edge_down(seg, start, stop, level, bg)  # columns counted outwards from ``core``
+    return core + step * edge

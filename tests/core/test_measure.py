@@ -1,0 +1,70 @@
+"""Columns of landmarks cut at one side: limbs and outline centres (core/measure.py, core/edges.limb)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rangebearing import Pipeline, load_config
+from rangebearing.core.edges import limb
+from rangebearing.core.measure import outline_centre
+from rangebearing.core.types import LandmarkGeometry
+from rangebearing.synth import Imaging, LandmarkPose, Scene, render
+
+GEOMETRY = LandmarkGeometry()
+NOISE = Imaging(blur_sigma_px=0.6, read_noise=0.004, shot_noise=0.0006)
+
+
+@pytest.mark.parametrize("phi_rad", [-0.42, -0.1, 0.0, 0.25, 0.45])
+@pytest.mark.parametrize("range_m", [0.22, 0.6, 1.5])
+def test_outline_centre_from_either_limb_is_the_mean_of_the_two_tangent_images(phi_rad, range_m):
+    f, cx = 634.0, 319.5
+    r = GEOMETRY.radius_m
+    alpha = math.asin(r / range_m)
+    left, right = (cx + f * math.tan(phi_rad + s * alpha) for s in (-1, 1))
+    # the white height as the camera sees it on the near surface, depth (d − r)·cos φ
+    white_m = GEOMETRY.height_m - 2 * GEOMETRY.band_height_m
+    white_px = f * white_m / ((range_m - r) * math.cos(phi_rad))
+    centre = 0.5 * (left + right)
+    assert outline_centre(right, True, cx, f, white_px, GEOMETRY) == pytest.approx(centre, abs=1e-3)
+    assert outline_centre(left, False, cx, f, white_px, GEOMETRY) == pytest.approx(centre, abs=1e-3)
+
+
+def _profile(n, edge, level, bg):
+    """A band of ``level`` up to column ``edge`` (sub-pixel, linear mixing), ``bg`` beyond."""
+    cols = np.arange(n, dtype=np.float64)
+    cover = np.clip(edge - (cols - 0.5), 0.0, 1.0)
+    return bg + (level - bg) * cover
+
+
+@pytest.mark.parametrize("edge", [20.0, 20.3, 20.75])
+def test_limb_is_the_two_level_edge_going_either_way(edge):
+    p = _profile(40, edge, 0.7, 0.02)
+    assert limb(p, 5, 39, 0.7) == pytest.approx(edge, abs=1e-6)
+    q = p[::-1].copy()  # the mirror image: the limb at 39 − edge, searched leftwards
+    assert limb(q, 34, 0, 0.7) == pytest.approx(39 - edge, abs=1e-6)
+
+
+def test_limb_stops_before_a_neighbours_band_of_the_same_colour():
+    p = _profile(40, 20.3, 0.7, 0.0)
+    p[27:] = 0.3  # a neighbour's band, only partly in these rows, starts a few columns beyond
+    assert limb(p, 5, 39, 0.7) == pytest.approx(20.3, abs=1e-6)
+
+
+def test_limb_is_nan_where_the_band_never_falls():
+    assert math.isnan(limb(np.full(30, 0.7), 3, 29, 0.7))
+
+
+def _bearings(*poses):
+    img = render(Scene(landmarks=tuple(poses), imaging=NOISE, wall_distance_m=2.5), np.random.default_rng(3))
+    found = Pipeline(load_config(None).pipeline, track=False).process(img).landmarks
+    return found
+
+
+@pytest.mark.parametrize("bearing_rad", [0.462, -0.462])
+def test_a_landmark_cut_by_the_frame_edge_is_placed_from_its_inner_limb(bearing_rad):
+    # at 0.3 m the frame edge (±26.8°) cuts about a third of the silhouette off
+    (lm,) = _bearings(LandmarkPose(0.3, bearing_rad))
+    assert lm.visible < 0.9
+    assert math.degrees(abs(lm.bearing_rad - bearing_rad)) < 0.15
+    assert lm.range_m == pytest.approx(0.3, rel=0.01)
