@@ -120,3 +120,23 @@ def test_the_search_is_bounded_by_max_landmarks_and_the_region_cap():
     reds = region_stats(((to_hsv(img)[..., 1] > 90) & (to_hsv(img)[..., 0] < 10)).astype(np.uint8) * 255, 2)
     assert len(reds) == 48  # the largest 48 of 96 regions
     assert len(region_pairs(reds, reds, 10)) <= 10
+
+
+def test_a_band_merged_with_a_red_thing_reaching_below_the_landmark_is_still_paired():
+    # a red poster beside the landmark touches its band and reaches below the blue band:
+    # the red region's box ends below the blue one's
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    img[15:90, 10:50] = RED
+    landmark(img, 50, 20, 9, 21)
+    (c,) = search(img)
+    assert c.red_bbox_px[0] == 50 and c.white_px == 24 and c.cut_left and not c.cut_right
+
+
+def test_a_band_merged_with_a_red_floor_below_is_still_paired():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    landmark(img, 50, 20, 9, 21)
+    img[62:120, 0:160] = RED  # a red floor right under the blue band, wider than the landmark
+    img[20:29, 71:75] = RED  # ... and joined to the red band by a red thing beside it
+    img[29:62, 71:75] = RED
+    (c,) = search(img)
+    assert c.red_bbox_px[:3] == (50, 20, 21) and c.white_px == 24

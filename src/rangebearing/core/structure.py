@@ -86,7 +86,14 @@ def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
 
 def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tuple[int, int]]:
     """Row indices of red and blue regions that may hold one landmark: shared columns, blue
-    reaching below red's bottom and starting no farther below it than a white body could be."""
+    starting no farther below red's bottom than a white body could be.
+
+    Band-shaped regions have blue reaching below red's bottom (blue may start above red when
+    it merged with a blue wall behind). A band merged with a same-coloured thing that reaches
+    lower (a red box, poster or floor mat beside or under it) has a region whose box ends below
+    the blue band's: such pairs are kept too when red starts above blue's bottom, and examined
+    after the band-shaped ones, widest shared columns first within each kind.
+    """
     if len(reds) == 0 or len(blues) == 0:
         return []
     rx0, ry0, rw, rh = (reds[:, k, None] for k in (1, 2, 3, 4))
@@ -94,10 +101,11 @@ def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tu
     overlap = np.minimum(rx0 + rw, bx0 + bw) - np.maximum(rx0, bx0)
     gap = by0 - (ry0 + rh)
     # a white body is 40/35 of the silhouette wide; a partly hidden one (30 % seen) shows less width
-    # blue may start above red when it merged with a blue wall behind; it must reach below red's bottom
-    ok = (overlap >= 2) & (by0 + bh > ry0 + rh) & (gap <= 4 * np.minimum(rw, bw) + 3)
-    i, j = np.nonzero(ok)
-    order = np.argsort(-overlap[i, j], kind="stable")[:max_pairs]
+    near = (overlap >= 2) & (gap <= 4 * np.minimum(rw, bw) + 3)
+    shaped = by0 + bh > ry0 + rh
+    merged = ~shaped & (by0 + bh > ry0 + 2)
+    i, j = np.nonzero(near & (shaped | merged))
+    order = np.lexsort((-overlap[i, j], merged[i, j]))[:max_pairs]
     return list(zip(i[order].tolist(), j[order].tolist()))
 
 
