@@ -21,7 +21,7 @@ from rangebearing.synth import generate
 # max p95 bearing error °. (The means are not bounded here: a rare gross error, e.g. a robot's red
 # flag in front of its own white body read as the band, still moves them; see docs/detection.md.)
 SETS = [
-    ("occlusion", 40, 6201, 0.90, 0.05, 3.0, 0.3),
+    ("occlusion", 40, 6201, 0.90, 0.1, 3.0, 0.3),
     ("crowd", 30, 6203, 0.85, 0.2, 4.0, 1.2),
     ("far", 40, 6204, 0.85, 0.05, 3.5, 0.3),
     ("touching", 40, 6202, 0.70, 0.15, 3.5, 1.0),
