@@ -26,7 +26,7 @@ All coordinates here are in the downscaled masks' pixels until
 from __future__ import annotations
 
 import dataclasses
-from typing import List, Tuple
+from typing import List, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -146,35 +146,118 @@ def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     return ok, b1, best, run_r, run_b
 
 
-def bridge(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def bridge(
+    ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] = ()
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fill gaps of up to ``BRIDGE`` columns between columns whose edges agree, and take the median
-    of three neighbours, so sensor noise neither breaks one structure into pieces nor jitters its edges."""
+    of three neighbours, so sensor noise neither breaks one structure into pieces nor jitters its edges.
+
+    ``starts``: where further windows begin when several are side by side in one array
+    (:func:`window_runs`); nothing is bridged or smoothed across them.
+    """
     ok, y1, y2 = ok.copy(), y1.astype(np.float64), y2.astype(np.float64)
+    n = len(ok)
+    seg = np.zeros(n, np.int64)
+    if len(starts):
+        seg[np.asarray(starts, np.int64)] = 1
+        seg = np.cumsum(seg)
     idx = np.flatnonzero(ok)
-    gaps = np.flatnonzero((np.diff(idx) > 1) & (np.diff(idx) <= BRIDGE + 1))  # usually none
+    d = np.diff(idx)
+    gaps = np.flatnonzero((d > 1) & (d <= BRIDGE + 1) & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
     for g in gaps.tolist():
         a, b = idx[g], idx[g + 1]
         if abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
             ok[a + 1 : b] = True
             y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
-    if len(ok) >= 3:
+    if n >= 3:
+        inner = (seg[:-2] == seg[1:-1]) & (seg[2:] == seg[1:-1])  # both neighbours in the same window
         for y in (y1, y2):
             a, b, c = y[:-2], y[1:-1], y[2:]
-            y[1:-1] = np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))  # median of three
+            y[1:-1] = np.where(inner, np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c)), b)
     return ok, y1, y2
 
 
-def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray) -> List[Tuple[int, int]]:
-    """``[start, stop)`` column ranges where the edges continue from column to column."""
+def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] = ()) -> List[Tuple[int, int]]:
+    """``[start, stop)`` column ranges where the edges continue from column to column (none across
+    the window ``starts`` of :func:`bridge`)."""
     step = EDGE_STEP + 0.05 * (y2 - y1)
     jump = np.zeros(len(ok), bool)
     jump[1:] = (np.abs(np.diff(y1)) > step[1:]) | (np.abs(np.diff(y2)) > step[1:])
     prev_ok = np.concatenate(([False], ok[:-1]))
     next_ok = np.concatenate((ok[1:], [False]))
+    if len(starts):
+        b = np.asarray(starts, np.int64)
+        prev_ok[b] = False
+        next_ok[b - 1] = False
     next_jump = np.concatenate((jump[1:], [True]))
-    starts = np.flatnonzero(ok & (~prev_ok | jump))
+    first = np.flatnonzero(ok & (~prev_ok | jump))
     stops = np.flatnonzero(ok & (~next_ok | next_jump)) + 1
-    return list(zip(starts.tolist(), stops.tolist()))
+    return list(zip(first.tolist(), stops.tolist()))
+
+
+Window = Tuple[int, int, int, int]  # y0, y1, x0, x1 of a pair's window in the masks
+RunStats = Tuple[int, int, float, float, float, float, float]  # s0, s1 and the run's medians (see window_runs)
+STACK_WASTE = 2  # a window joins a stack of taller ones while it is at least 1/STACK_WASTE of their height
+
+
+def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) -> List[List[RunStats]]:
+    """The runs of every pair window, searched together.
+
+    The windows are put side by side, top-aligned, into a few stacked arrays
+    (columns are independent in :func:`column_edges`, and the empty rows padded
+    below a window change none of its columns), so a frame's column search is a
+    handful of array calls however many pairs it has.
+
+    Returns, per window, ``(s0, s1, gap, run_r, run_b, y1, y2)`` per run: its
+    columns ``[s0, s1)`` in the window and the medians over them of the white gap
+    ``y2 − y1 − 1``, the red and blue run lengths and the (bridged, smoothed)
+    edges, window rows.
+    """
+    out: List[List[RunStats]] = [[] for _ in wins]
+    heights = [w[1] - w[0] for w in wins]
+    order = sorted(range(len(wins)), key=lambda k: -heights[k])
+    while order:
+        top = heights[order[0]]
+        batch = [k for k in order if heights[k] * STACK_WASTE >= top]
+        order = [k for k in order if heights[k] * STACK_WASTE < top]
+        widths = [wins[k][3] - wins[k][2] for k in batch]
+        offs = np.concatenate(([0], np.cumsum(widths))).astype(np.int64)
+        r = np.zeros((top, int(offs[-1])), np.uint8)
+        b = np.zeros_like(r)
+        sv = np.zeros((top, int(offs[-1]), 2), np.uint8)
+        for k, o, w in zip(batch, offs.tolist(), widths):
+            y0, y1, x0, x1 = wins[k]
+            h = y1 - y0
+            r[:h, o : o + w] = red[y0:y1, x0:x1]
+            b[:h, o : o + w] = blue[y0:y1, x0:x1]
+            sv[:h, o : o + w] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:]
+        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= WHITE_V_MIN)  # padding: V = 0, not white
+        ok, e1, e2, run_r, run_b = column_edges(r > 0, b > 0, white)
+        starts = offs[1:-1]
+        ok, e1, e2 = bridge(ok, e1, e2, starts)
+        found = runs(ok, e1, e2, starts)
+        if not found:
+            continue
+        s0 = np.array([f[0] for f in found], np.int64)
+        s1 = np.array([f[1] for f in found], np.int64)
+        med = _run_medians(np.stack((e2 - e1 - 1, run_r, run_b, e1, e2)), s0, s1)
+        owner = np.searchsorted(offs, s0, side="right") - 1
+        for q, (a, z, w_k) in enumerate(zip(s0.tolist(), s1.tolist(), owner.tolist())):
+            o = int(offs[w_k])
+            out[batch[w_k]].append((a - o, z - o, *(float(v) for v in med[:, q])))
+    return out
+
+
+def _run_medians(values: np.ndarray, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
+    """(K, R) medians of each of K value rows over each run's columns ``[s0, s1)`` (``np.median``'s values)."""
+    n = s1 - s0
+    cols = s0[:, None] + np.arange(int(n.max()))[None, :]
+    inside = cols < s1[:, None]
+    v = np.where(inside[None], values[:, np.minimum(cols, values.shape[1] - 1)].astype(np.float64), np.inf)
+    v.sort(axis=2)
+    lo, hi = (n - 1) // 2, n // 2
+    k = np.arange(len(n))
+    return 0.5 * (v[:, k, lo] + v[:, k, hi])  # odd n: lo = hi, the middle value itself
 
 
 def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
@@ -182,7 +265,7 @@ def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
     if col < 0 or col >= mask.shape[1]:
         return False
     seg = mask[max(0, rows[0]) : max(0, rows[1]), col]
-    return seg.size > 0 and float(seg.mean()) > 127.0
+    return seg.size > 0 and 255 * np.count_nonzero(seg) > 127 * seg.size  # mean > 127 of a 0/255 mask
 
 
 def candidates(
@@ -206,23 +289,21 @@ def candidates(
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
     out: List[Candidate] = []
     taken: List[BBox] = []
-    for i, j in region_pairs(reds, blues, MAX_PAIRS_PER_LANDMARK * max_landmarks):
-        r, b = reds[i], blues[j]
-        x0, x1 = max(r[1], b[1]), min(r[1] + r[3], b[1] + b[3])
-        y0, y1 = r[2], b[2] + b[4]
-        win = (slice(y0, y1), slice(x0, x1))
-        white = (hsv[win][..., 1] < WHITE_S_MAX) & (hsv[win][..., 2] >= WHITE_V_MIN)
-        ok, e1, e2, run_r, run_b = column_edges(red[win] > 0, blue[win] > 0, white)
-        ok, e1, e2 = bridge(ok, e1, e2)
-        for s0, s1 in runs(ok, e1, e2):
+    pairs = region_pairs(reds, blues, MAX_PAIRS_PER_LANDMARK * max_landmarks)
+    wins = [
+        (int(reds[i, 2]), int(blues[j, 2] + blues[j, 4]), int(max(reds[i, 1], blues[j, 1])),
+         int(min(reds[i, 1] + reds[i, 3], blues[j, 1] + blues[j, 3])))
+        for i, j in pairs
+    ]
+    for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins)):
+        for s0, s1, gap, med_r, med_b, med_1, med_2 in found:
             n = s1 - s0
-            gap = float(np.median(e2[s0:s1] - e1[s0:s1] - 1))
             if gap < 2:  # bridged or smoothed below the thinnest white body
                 continue
             hb, w_exp = band_k * gap, width_k * gap
             ratio = n / w_exp
-            red_merged = float(np.median(run_r[s0:s1])) > MERGED * hb + 1
-            blue_merged = float(np.median(run_b[s0:s1])) > MERGED * hb + 1
+            red_merged = med_r > MERGED * hb + 1
+            blue_merged = med_b > MERGED * hb + 1
             k = round(ratio)
             if ratio > 1 + SPLIT_TOL:
                 if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
@@ -232,8 +313,8 @@ def candidates(
                 continue
             else:
                 pieces = [(float(s0), float(s1))]
-            ey1 = float(np.median(e1[s0:s1])) + y0
-            ey2 = float(np.median(e2[s0:s1])) + y0
+            ey1 = med_1 + y0
+            ey2 = med_2 + y0
             rrows = (round(ey1 - hb + 1), int(ey1) + 1)
             brows = (int(ey2), round(ey2 + hb))
             reach = 1 + round(0.08 * w_exp)
