@@ -26,23 +26,20 @@ All coordinates here are in the downscaled masks' pixels until
 from __future__ import annotations
 
 import dataclasses
-from typing import List, Sequence, Tuple
+from typing import List, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
+from .columns import bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .types import BBox, LandmarkGeometry
 
 MAX_REGIONS = 48  # largest regions of each colour considered (bounds the cost of a frame full of specks)
 MAX_PAIRS_PER_LANDMARK = 4  # region pairs examined per landmark wanted
-WHITE_SHARE = 0.6  # share of the rows between the edges that must be white
-EDGE_STEP = 1  # largest jump of an edge between neighbouring columns (plus 5 % of h)
 MERGED = 1.7  # a band run longer than this many expected band heights is merged with something
 SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
 MIN_VISIBLE = 0.5  # narrower runs than this share of a silhouette are not reported (findable: 60 %)
-BRIDGE = 2  # columns of a gap bridged between agreeing edges
-WHITE_S_MAX, WHITE_V_MIN = 80, 40  # the white body: low saturation, not dark
 
 
 @frozen
@@ -107,157 +104,6 @@ def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tu
     i, j = np.nonzero(near & (shaped | merged))
     order = np.lexsort((-overlap[i, j], merged[i, j]))[:max_pairs]
     return list(zip(i[order].tolist(), j[order].tolist()))
-
-
-def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[np.ndarray, ...]:
-    """Per column of a window: ``(ok, y1, y2, run_r, run_b)``.
-
-    ``y1`` is the last red row above the blue-top row ``y2``, with at least
-    ``WHITE_SHARE`` of the rows between them white; of several such pairs in a
-    column, the whitest (then the shortest) wins. ``run_r``/``run_b`` are the
-    lengths of the red run ending at ``y1`` and the blue run starting at ``y2``.
-    """
-    h, w = red.shape
-    rows = np.arange(h, dtype=np.int32)[:, None]
-    red_bottom = red.copy()
-    red_bottom[:-1] &= ~red[1:]
-    red_bottom[-1] = False
-    last_rb = np.maximum.accumulate(np.where(red_bottom, rows, -1), axis=0)
-    last_not_red = np.maximum.accumulate(np.where(red, -1, rows), axis=0)
-    next_not_blue = np.minimum.accumulate(np.where(blue, h, rows)[::-1], axis=0)[::-1]
-    blue_top = blue.copy()
-    blue_top[1:] &= ~blue[:-1]
-    blue_top[0] = False
-    cum_w = np.cumsum(white, axis=0, dtype=np.int32)
-    cols = np.arange(w)
-    y1 = np.empty_like(last_rb)
-    y1[0], y1[1:] = -1, last_rb[:-1]  # the last red bottom above each row
-    gap = rows - y1 - 1
-    whites = np.empty_like(cum_w)  # white rows strictly between y1 and this row
-    whites[0] = 0
-    whites[1:] = cum_w[:-1] - cum_w[np.maximum(y1[1:], 0), cols]
-    valid = blue_top & (y1 >= 0) & (gap >= 2) & (whites >= WHITE_SHARE * gap)
-    share = np.where(valid, whites / np.maximum(gap, 1) - 1e-3 * gap, -1.0)
-    best = np.argmax(share, axis=0)
-    ok = share[best, cols] > -1.0
-    b1 = y1[best, cols]
-    run_r = b1 - last_not_red[np.maximum(b1, 0), cols]
-    run_b = next_not_blue[best, cols] - best
-    return ok, b1, best, run_r, run_b
-
-
-def bridge(
-    ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] = ()
-) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Fill gaps of up to ``BRIDGE`` columns between columns whose edges agree, and take the median
-    of three neighbours, so sensor noise neither breaks one structure into pieces nor jitters its edges.
-
-    ``starts``: where further windows begin when several are side by side in one array
-    (:func:`window_runs`); nothing is bridged or smoothed across them.
-    """
-    ok, y1, y2 = ok.copy(), y1.astype(np.float64), y2.astype(np.float64)
-    n = len(ok)
-    seg = np.zeros(n, np.int64)
-    if len(starts):
-        seg[np.asarray(starts, np.int64)] = 1
-        seg = np.cumsum(seg)
-    idx = np.flatnonzero(ok)
-    d = np.diff(idx)
-    gaps = np.flatnonzero((d > 1) & (d <= BRIDGE + 1) & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
-    for g in gaps.tolist():
-        a, b = idx[g], idx[g + 1]
-        if abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
-            ok[a + 1 : b] = True
-            y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
-    if n >= 3:
-        inner = (seg[:-2] == seg[1:-1]) & (seg[2:] == seg[1:-1])  # both neighbours in the same window
-        for y in (y1, y2):
-            a, b, c = y[:-2], y[1:-1], y[2:]
-            y[1:-1] = np.where(inner, np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c)), b)
-    return ok, y1, y2
-
-
-def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] = ()) -> List[Tuple[int, int]]:
-    """``[start, stop)`` column ranges where the edges continue from column to column (none across
-    the window ``starts`` of :func:`bridge`)."""
-    step = EDGE_STEP + 0.05 * (y2 - y1)
-    jump = np.zeros(len(ok), bool)
-    jump[1:] = (np.abs(np.diff(y1)) > step[1:]) | (np.abs(np.diff(y2)) > step[1:])
-    prev_ok = np.concatenate(([False], ok[:-1]))
-    next_ok = np.concatenate((ok[1:], [False]))
-    if len(starts):
-        b = np.asarray(starts, np.int64)
-        prev_ok[b] = False
-        next_ok[b - 1] = False
-    next_jump = np.concatenate((jump[1:], [True]))
-    first = np.flatnonzero(ok & (~prev_ok | jump))
-    stops = np.flatnonzero(ok & (~next_ok | next_jump)) + 1
-    return list(zip(first.tolist(), stops.tolist()))
-
-
-Window = Tuple[int, int, int, int]  # y0, y1, x0, x1 of a pair's window in the masks
-RunStats = Tuple[int, int, float, float, float, float, float]  # s0, s1 and the run's medians (see window_runs)
-STACK_WASTE = 2  # a window joins a stack of taller ones while it is at least 1/STACK_WASTE of their height
-
-
-def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) -> List[List[RunStats]]:
-    """The runs of every pair window, searched together.
-
-    The windows are put side by side, top-aligned, into a few stacked arrays
-    (columns are independent in :func:`column_edges`, and the empty rows padded
-    below a window change none of its columns), so a frame's column search is a
-    handful of array calls however many pairs it has.
-
-    Returns, per window, ``(s0, s1, gap, run_r, run_b, y1, y2)`` per run: its
-    columns ``[s0, s1)`` in the window and the medians over them of the white gap
-    ``y2 − y1 − 1``, the red and blue run lengths and the (bridged, smoothed)
-    edges, window rows.
-    """
-    out: List[List[RunStats]] = [[] for _ in wins]
-    heights = [w[1] - w[0] for w in wins]
-    order = sorted(range(len(wins)), key=lambda k: -heights[k])
-    while order:
-        top = heights[order[0]]
-        batch = [k for k in order if heights[k] * STACK_WASTE >= top]
-        order = [k for k in order if heights[k] * STACK_WASTE < top]
-        widths = [wins[k][3] - wins[k][2] for k in batch]
-        offs = np.concatenate(([0], np.cumsum(widths))).astype(np.int64)
-        r = np.zeros((top, int(offs[-1])), np.uint8)
-        b = np.zeros_like(r)
-        sv = np.zeros((top, int(offs[-1]), 2), np.uint8)
-        for k, o, w in zip(batch, offs.tolist(), widths):
-            y0, y1, x0, x1 = wins[k]
-            h = y1 - y0
-            r[:h, o : o + w] = red[y0:y1, x0:x1]
-            b[:h, o : o + w] = blue[y0:y1, x0:x1]
-            sv[:h, o : o + w] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:]
-        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= WHITE_V_MIN)  # padding: V = 0, not white
-        ok, e1, e2, run_r, run_b = column_edges(r > 0, b > 0, white)
-        starts = offs[1:-1]
-        ok, e1, e2 = bridge(ok, e1, e2, starts)
-        found = runs(ok, e1, e2, starts)
-        if not found:
-            continue
-        s0 = np.array([f[0] for f in found], np.int64)
-        s1 = np.array([f[1] for f in found], np.int64)
-        med = _run_medians(np.stack((e2 - e1 - 1, run_r, run_b, e1, e2)), s0, s1)
-        owner = np.searchsorted(offs, s0, side="right") - 1
-        for q, (a, z, w_k) in enumerate(zip(s0.tolist(), s1.tolist(), owner.tolist())):
-            o = int(offs[w_k])
-            out[batch[w_k]].append((a - o, z - o, *(float(v) for v in med[:, q])))
-    return out
-
-
-def _run_medians(values: np.ndarray, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
-    """(K, R) medians of each of K value rows over each run's columns ``[s0, s1)`` (``np.median``'s values)."""
-    n = s1 - s0
-    cols = s0[:, None] + np.arange(int(n.max()))[None, :]
-    inside = cols < s1[:, None]
-    v = np.where(inside[None], values[:, np.minimum(cols, values.shape[1] - 1)].astype(np.float64), np.inf)
-    v.sort(axis=2)
-    lo, hi = (n - 1) // 2, n // 2
-    k = np.arange(len(n))
-    return 0.5 * (v[:, k, lo] + v[:, k, hi])  # odd n: lo = hi, the middle value itself
 
 
 def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
