@@ -24,34 +24,72 @@ def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     ``WHITE_SHARE`` of the rows between them white; of several such pairs in a
     column, the whitest (then the shortest) wins. ``run_r``/``run_b`` are the
     lengths of the red run ending at ``y1`` and the blue run starting at ``y2``.
+    Where no pair qualifies ``ok`` is False, ``y1`` −1 and ``y2`` 0.
     """
-    h, w = red.shape
-    rows = np.arange(h, dtype=np.int32)[:, None]
-    red_bottom = red.copy()
-    red_bottom[:-1] &= ~red[1:]
-    red_bottom[-1] = False
-    last_rb = np.maximum.accumulate(np.where(red_bottom, rows, -1), axis=0)
-    last_not_red = np.maximum.accumulate(np.where(red, -1, rows), axis=0)
-    next_not_blue = np.minimum.accumulate(np.where(blue, h, rows)[::-1], axis=0)[::-1]
-    blue_top = blue.copy()
-    blue_top[1:] &= ~blue[:-1]
-    blue_top[0] = False
-    cum_w = np.cumsum(white, axis=0, dtype=np.int32)
-    cols = np.arange(w)
-    y1 = np.empty_like(last_rb)
-    y1[0], y1[1:] = -1, last_rb[:-1]  # the last red bottom above each row
-    gap = rows - y1 - 1
-    whites = np.empty_like(cum_w)  # white rows strictly between y1 and this row
-    whites[0] = 0
-    whites[1:] = cum_w[:-1] - cum_w[np.maximum(y1[1:], 0), cols]
-    valid = blue_top & (y1 >= 0) & (gap >= 2) & (whites >= WHITE_SHARE * gap)
-    share = np.where(valid, whites / np.maximum(gap, 1) - 1e-3 * gap, -1.0)
-    best = np.argmax(share, axis=0)
-    ok = share[best, cols] > -1.0
-    b1 = y1[best, cols]
-    run_r = b1 - last_not_red[np.maximum(b1, 0), cols]
-    run_b = next_not_blue[best, cols] - best
-    return ok, b1, best, run_r, run_b
+    return scan_columns(np.ascontiguousarray(red.T), np.ascontiguousarray(blue.T), np.ascontiguousarray(white.T))
+
+
+def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[np.ndarray, ...]:
+    """:func:`column_edges` of (W, H) bool arrays, one row per image column (C order).
+
+    The work is on the few colour changes of each column, not on its pixels:
+    red bottoms, red tops, blue tops and blue bottoms are found once, flattened
+    in column order, and each blue top is joined to the red bottom above it by
+    a binary search, so a window costs some twenty array calls whatever its size.
+    """
+    w, h = red.shape
+    base = np.arange(w, dtype=np.int64) * h  # flat index of each column's row 0
+    edge = red.copy()
+    edge[:, :-1] &= ~red[:, 1:]
+    edge[:, -1] = False
+    red_bottoms = np.flatnonzero(edge)
+    edge = red.copy()
+    edge[:, 1:] &= ~red[:, :-1]
+    red_tops = np.flatnonzero(edge)
+    edge = blue.copy()
+    edge[:, 1:] &= ~blue[:, :-1]
+    edge[:, 0] = False
+    tops = np.flatnonzero(edge)
+    edge = blue.copy()
+    edge[:, :-1] &= ~blue[:, 1:]
+    blue_bottoms = np.flatnonzero(edge)
+    col = tops // h
+    # the last red bottom above each blue top, in its column (else none: -1)
+    k = np.searchsorted(red_bottoms, tops) - 1
+    above = red_bottoms[np.maximum(k, 0)] if len(red_bottoms) else np.zeros(len(tops), np.int64)
+    has = (k >= 0) & (above >= base[col])
+    row = tops - base[col]
+    y1 = np.where(has, above - base[col], -1)
+    gap = row - y1 - 1
+    cum_w = np.cumsum(white.reshape(-1), dtype=np.int32)
+    whites = cum_w[tops - 1] - cum_w[np.where(has, above, 0)]  # white rows strictly between y1 and the top
+    valid = has & (gap >= 2) & (whites >= WHITE_SHARE * gap)
+    share = whites / np.maximum(gap, 1) - 1e-3 * gap
+    ok = np.zeros(w, bool)
+    y2 = np.zeros(w, np.int64)
+    b1 = np.full(w, -1, np.int64)
+    v = np.flatnonzero(valid)
+    if len(v):
+        v = v[np.lexsort((row[v], -share[v], col[v]))]  # per column: whitest, then the shortest
+        cv = col[v]
+        first = np.ones(len(v), bool)
+        first[1:] = cv[1:] != cv[:-1]
+        v, cv = v[first], cv[first]
+        ok[cv], y2[cv], b1[cv] = True, row[v], y1[v]
+    # red run ending at y1 (start: the last red top at or above it); without a pair, as at y1 = -1 → row 0
+    run_r = np.where(red[:, 0], 0, -1)
+    if ok.any():
+        c = np.flatnonzero(ok)
+        q = base[c] + b1[c]
+        run_r[c] = q - red_tops[np.searchsorted(red_tops, q, side="right") - 1] + 1
+    # blue run starting at y2 (end: the first blue bottom at or below it); without a pair, from row 0
+    start = base + y2
+    run_b = np.zeros(w, np.int64)
+    in_blue = blue[np.arange(w), y2]
+    if in_blue.any():
+        c = np.flatnonzero(in_blue)
+        run_b[c] = blue_bottoms[np.searchsorted(blue_bottoms, start[c])] - start[c] + 1
+    return ok, b1, y2, run_r, run_b
 
 
 def bridge(
@@ -105,7 +143,7 @@ def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] =
 
 Window = Tuple[int, int, int, int]  # y0, y1, x0, x1 of a pair's window in the masks
 RunStats = Tuple[int, int, float, float, float, float, float]  # s0, s1 and the run's medians (see window_runs)
-STACK_WASTE = 2  # a window joins a stack of taller ones while it is at least 1/STACK_WASTE of their height
+STACK_WASTE = 4  # a window joins a stack of taller ones while it is at least 1/STACK_WASTE of their height
 
 
 def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) -> List[List[RunStats]]:
@@ -114,7 +152,8 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) 
     The windows are put side by side, top-aligned, into a few stacked arrays
     (columns are independent in :func:`column_edges`, and the empty rows padded
     below a window change none of its columns), so a frame's column search is a
-    handful of array calls however many pairs it has.
+    handful of array calls however many pairs it has. Windows of very different
+    heights go into different stacks, so padding never costs much.
 
     Returns, per window, ``(s0, s1, gap, run_r, run_b, y1, y2)`` per run: its
     columns ``[s0, s1)`` in the window and the medians over them of the white gap
@@ -130,17 +169,17 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) 
         order = [k for k in order if heights[k] * STACK_WASTE < top]
         widths = [wins[k][3] - wins[k][2] for k in batch]
         offs = np.concatenate(([0], np.cumsum(widths))).astype(np.int64)
-        r = np.zeros((top, int(offs[-1])), np.uint8)
+        r = np.zeros((int(offs[-1]), top), np.uint8)  # one row per window column (see scan_columns)
         b = np.zeros_like(r)
-        sv = np.zeros((top, int(offs[-1]), 2), np.uint8)
+        sv = np.zeros((*r.shape, 2), np.uint8)  # padding: no colour, V = 0 is not white
         for k, o, w in zip(batch, offs.tolist(), widths):
             y0, y1, x0, x1 = wins[k]
             h = y1 - y0
-            r[:h, o : o + w] = red[y0:y1, x0:x1]
-            b[:h, o : o + w] = blue[y0:y1, x0:x1]
-            sv[:h, o : o + w] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:]
-        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= WHITE_V_MIN)  # padding: V = 0, not white
-        ok, e1, e2, run_r, run_b = column_edges(r > 0, b > 0, white)
+            r[o : o + w, :h] = red[y0:y1, x0:x1].T
+            b[o : o + w, :h] = blue[y0:y1, x0:x1].T
+            sv[o : o + w, :h] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:].transpose(1, 0, 2)
+        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= WHITE_V_MIN)
+        ok, e1, e2, run_r, run_b = scan_columns(r > 0, b > 0, white)
         starts = offs[1:-1]
         ok, e1, e2 = bridge(ok, e1, e2, starts)
         found = runs(ok, e1, e2, starts)

@@ -104,8 +104,8 @@ def measure_rows(
     hb, hw = band_px / f, c.white_px / f
     r_exp = (ry + 0.5 * rh - oy) / f - 0.5
     b_exp = (by + 0.5 * bh - oy) / f - 0.5
-    red = _band(er, r_exp, hb, hw, True)
-    blue = _band(eb, b_exp, hb, hw, False)
+    red = _band(er, er.mean(axis=1), r_exp, hb, hw, True)
+    blue = _band(eb, eb.mean(axis=1), b_exp, hb, hw, False)
     if red is None or blue is None or not blue.inner > red.inner:
         return None
     white = blue.inner - red.inner
@@ -123,13 +123,13 @@ def measure_rows(
     )
 
 
-def _band(p2d: np.ndarray, expected: float, hb: float, hw: float, red: bool):
-    """:func:`.edges.band_rows` around the row of strongest colour near ``expected``."""
+def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool):
+    """:func:`.edges.band_rows` around the row of strongest colour near ``expected`` (``p``: the row profile)."""
     n = p2d.shape[0]
     lo, hi = max(0, int(expected - 0.5 * hb - 3)), min(n, int(expected + 0.5 * hb + 4))
     if hi <= lo:
         return None
-    prof = p2d[lo:hi].mean(axis=1)
+    prof = p[lo:hi]  # rows' means do not depend on the other rows
     top = int(np.argmax(prof))
     strong = prof >= 0.5 * prof[top]
     first, last = top, top  # the band's rows: the run of strong colour around the strongest row
@@ -142,8 +142,8 @@ def _band(p2d: np.ndarray, expected: float, hb: float, hw: float, red: bool):
     into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther
     beyond = round(0.5 * hb + 3)
     if red:
-        return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond)
-    return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond)
+        return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p)
+    return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p)
 
 
 def measure_columns(

@@ -1,0 +1,85 @@
+"""The column scan: the event-based search against a plain per-column reference, and the stacked windows
+against each window scanned on its own."""
+
+import numpy as np
+import pytest
+
+from rangebearing.core.columns import WHITE_SHARE, bridge, column_edges, runs, window_runs
+
+
+def reference_column(red, blue, white):
+    """``(ok, y1, y2, run_r, run_b)`` of one column, pixel by pixel, as the docstring of column_edges says."""
+    h = len(red)
+    best = None
+    for y2 in range(1, h):
+        if not blue[y2] or blue[y2 - 1]:
+            continue  # not a blue top
+        bottoms = [y for y in range(y2) if red[y] and not red[y + 1]]
+        if not bottoms:
+            continue
+        y1 = bottoms[-1]
+        gap = y2 - y1 - 1
+        whites = int(sum(white[y1 + 1 : y2]))
+        if gap < 2 or whites < WHITE_SHARE * gap:
+            continue
+        share = whites / gap - 1e-3 * gap
+        if best is None or share > best[0]:
+            best = (share, y1, y2)
+    if best is None:
+        y1, y2, ok = -1, 0, False
+        run_r = 0 if red[0] else -1
+    else:
+        _, y1, y2, ok = (*best, True)
+        start = y1
+        while start > 0 and red[start - 1]:
+            start -= 1
+        run_r = y1 - start + 1
+    end = y2
+    while end < h and blue[end]:
+        end += 1
+    return ok, y1, y2, run_r, end - y2
+
+
+def random_window(rng, h, w):
+    """Columns of class runs (none/red/blue/white, 1-4 rows long) plus white speckle."""
+    cls = np.zeros((h, w), int)
+    for x in range(w):
+        y = 0
+        while y < h:
+            n = int(rng.integers(1, 5))
+            cls[y : y + n, x] = rng.integers(0, 4)
+            y += n
+    white = (cls == 3) | (rng.random((h, w)) < 0.15)
+    return cls == 1, cls == 2, white & (cls == 0) | (cls == 3)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_column_edges_match_a_pixel_by_pixel_reference(seed):
+    rng = np.random.default_rng(seed)
+    for _ in range(40):
+        h, w = int(rng.integers(1, 30)), int(rng.integers(1, 12))
+        red, blue, white = random_window(rng, h, w)
+        got = column_edges(red, blue, white)
+        for x in range(w):
+            assert tuple(int(a[x]) for a in got) == tuple(int(v) for v in reference_column(red[:, x], blue[:, x],
+                                                                                          white[:, x]))
+
+
+def test_stacked_windows_give_each_window_its_own_runs():
+    rng = np.random.default_rng(7)
+    h, w = 60, 90
+    red, blue, white = random_window(rng, h, w)
+    hsv = np.zeros((h, w, 3), np.uint8)
+    hsv[..., 1] = np.where(white, 10, 200)
+    hsv[..., 2] = 200
+    masks = red.astype(np.uint8) * 255, blue.astype(np.uint8) * 255
+    wins = [(0, 60, 0, 30), (5, 25, 20, 50), (10, 58, 40, 90), (30, 35, 0, 4), (0, 8, 60, 61)]
+    got = window_runs(*masks, hsv, wins)
+    for (y0, y1, x0, x1), found in zip(wins, got):
+        ok, e1, e2, run_r, run_b = column_edges(red[y0:y1, x0:x1], blue[y0:y1, x0:x1], white[y0:y1, x0:x1])
+        ok, e1, e2 = bridge(ok, e1, e2)
+        want = [
+            (s0, s1, *(float(np.median(v[s0:s1])) for v in (e2 - e1 - 1, run_r, run_b, e1, e2)))
+            for s0, s1 in runs(ok, e1, e2)
+        ]
+        assert found == want
