@@ -21,7 +21,7 @@ import numpy as np
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, find_candidates, refine
-from .identity import IdentityState, empty_state, identify
+from .identity import IdentityState, empty_state, update
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .params import PipelineParams
@@ -146,33 +146,31 @@ class Pipeline:
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close)
-        landmarks = sorted(
-            (lm for lm in map(self._landmark, found, [cam] * len(found)) if lm.range_m > 0), key=lambda lm: lm.range_m
+        readings = sorted((r for r in map(self._reading, found, [cam] * len(found)) if r[0] > 0), key=_range)
+        if not self.ids:
+            return FrameResult(landmarks=tuple(Landmark(*r) for r in readings), tracked=tracked)
+        # the identity filter's own call (identify() would build every Landmark a second time to add the ids)
+        self._identity, out = update(
+            self._identity, [r[0] for r in readings], [r[1] for r in readings], [r[10] for r in readings],
+            [r[11] for r in readings], t_s, None, [r[12] for r in readings],
         )
-        if self.ids:
-            self._identity, labelled = identify(self._identity, landmarks, t_s)
-            return FrameResult(landmarks=labelled, tracked=tracked)
-        return FrameResult(landmarks=tuple(landmarks), tracked=tracked)
+        landmarks = tuple(
+            Landmark(*r, int(tid), None if rr != rr else float(rr), None if br != br else float(br))  # NaN: no rate yet
+            for r, tid, rr, br in zip(readings, out.track_id.tolist(), out.range_rate_mps.tolist(),
+                                      out.bearing_rate_radps.tolist())
+        )
+        return FrameResult(landmarks=landmarks, tracked=tracked)
 
-    def _landmark(self, c: BandCentroids, cam: CameraIntrinsics) -> Landmark:
+    def _reading(self, c: BandCentroids, cam: CameraIntrinsics) -> tuple:
+        """A :class:`Landmark`'s fields up to ``visible``, in its order (the ids come after)."""
         model = self.params.model
         rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, model, self.params.landmark)
         c_m = model.c_m if model.kind == "pinhole" else 0.0
-        s_r, s_b = reading_sigma(
-            rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, c.width_px, c.visible, c_m, cam.fx_px
-        )
-        return Landmark(
-            range_m=rng,
-            bearing_rad=bearing,
-            d_v_m=d_v,
-            d_h_m=d_h,
-            l_px=l_px,
-            red_xy_px=c.red_xy_px,
-            blue_xy_px=c.blue_xy_px,
-            width_px=c.width_px,
-            bbox_px=c.bbox_px,
-            in_envelope=in_envelope(rng, bearing, self.params.model),
-            range_sigma_m=s_r,
-            bearing_sigma_rad=s_b,
-            visible=c.visible,
-        )
+        width_px = c.width_px
+        s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px)
+        return (rng, bearing, d_v, d_h, l_px, c.red_xy_px, c.blue_xy_px, width_px, c.bbox_px,
+                in_envelope(rng, bearing, model), s_r, s_b, c.visible)
+
+
+def _range(r: tuple) -> float:
+    return r[0]

@@ -130,6 +130,7 @@ class Landmark:
     ``d_v_m`` is the depth along the optical axis and ``d_h_m`` the lateral
     offset (positive left), as in the paper's figure 3; ``range_m`` is measured
     in the horizontal plane from the camera centre to the landmark's axis.
+    The pipeline builds it positionally, once per reading: keep new fields at the end.
     """
 
     range_m: float
