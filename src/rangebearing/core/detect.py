@@ -20,7 +20,7 @@ in place instead.
 
 from __future__ import annotations
 
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -29,7 +29,7 @@ from .._compat import frozen
 from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
-from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows
+from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
 from .structure import Candidate, candidates
@@ -114,8 +114,14 @@ def refine(
     # the boxes come from edges found at 1/downscale: grow them by that and a quarter of the band
     margins = [(m, m + b[3] // 4) for b in boxes]
     fixes = measure_bands(bgr, boxes, [True, False] * len(cands), margins, cfg, gains, pyramid)
-    found = (combine(bgr, c, r, b, gains, geometry, fy_px, pyramid) for c, r, b in zip(cands, fixes[0::2], fixes[1::2]))
+    live = [(c, r, b) for c, r, b in zip(cands, fixes[0::2], fixes[1::2]) if r is not None and b is not None]
+    rows = measure_rows_all(bgr, [c for c, _, _ in live], gains, geometry,
+                            [0.5 * (r.xy_px[0] + b.xy_px[0]) for _, r, b in live])
+    found = (combine(bgr, c, r, b, gains, geometry, fy_px, pyramid, rw) for (c, r, b), rw in zip(live, rows))
     return [f for f in found if f is not None]
+
+
+_MEASURE = object()  # combine's default: measure the rows itself
 
 
 def combine(
@@ -127,11 +133,17 @@ def combine(
     geometry: LandmarkGeometry,
     fy_px: float,
     pyramid: Optional[Pyramid] = None,
+    rows: Any = _MEASURE,
 ) -> Optional[BandCentroids]:
-    """One candidate's band centres from its moments (``red``, ``blue``) and its edges; ``None`` if a band is gone."""
+    """One candidate's band centres from its moments (``red``, ``blue``) and its edges; ``None`` if a band is gone.
+
+    ``rows``: what :func:`.measure.measure_rows` gives for the candidate at the bands'
+    mean column, when the caller measured all candidates' rows at once.
+    """
     if red is None or blue is None:
         return None
-    rows = measure_rows(bgr, c, gains, geometry, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
+    if rows is _MEASURE:
+        rows = measure_rows(bgr, c, gains, geometry, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
     if rows is None:
         return None
     # the band spacing and the white body's height are two measures of one size: they must agree

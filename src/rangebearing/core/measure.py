@@ -13,7 +13,7 @@ touching it) is placed from its other limb, half a silhouette away.
 from __future__ import annotations
 
 import math
-from typing import Optional, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -80,27 +80,87 @@ def measure_rows(
     (the landmark's measured centre, when it is seen whole; limbs curve and
     darken), so a full scan and a tracking window use the same columns.
     """
+    return measure_rows_all(bgr, [c], gains, geometry, [x_px])[0]
+
+
+RowWindow = Tuple[int, int, int, int, int, float, float]  # x0, y0, x1, y1, column step, then [a, b]
+
+
+def _row_window(shape: Tuple[int, ...], c: Candidate, geometry: LandmarkGeometry,
+                x_px: Optional[float]) -> Optional[RowWindow]:
+    """The frame region (clipped) whose column profile :func:`measure_rows` reads, or ``None`` if empty."""
     white_m = geometry.height_m - 2 * geometry.band_height_m
     band_px = c.white_px * geometry.band_height_m / white_m
-    f = 1
-    rx, ry, rw, rh = c.red_bbox_px
+    rx, ry, rw, _ = c.red_bbox_px
     by, bh = c.blue_bbox_px[1], c.blue_bbox_px[3]
     whole = cut_sides(c, bgr.shape[1]) == (False, False)
     a, b = (x_px - rw / 3, x_px + rw / 3) if x_px is not None and whole else (rx, rx + rw)
     cx0, cx1 = int(np.floor(a + 0.5)), int(np.ceil(b - 0.5)) + 1
     step = _step(cx1 - cx0)
     pad = int(band_px) + 6
-    tile, ox, oy = _tile(bgr, cx0, ry - pad, cx1, by + bh + pad, col_step=step)
-    if tile.shape[1] < 1:
+    h, w = shape[:2]
+    x0, y0, x1, y1 = max(0, cx0), max(0, ry - pad), min(w, cx1), min(h, by + bh + pad)
+    if x1 <= x0 or y1 <= y0:  # no column (or no row: no band rows to find)
         return None
-    er, eb = excess(tile, gains)
-    # end columns count by the share of them inside [a, b]: the profile moves smoothly with x
-    cols = ox + step * np.arange(tile.shape[1])
-    wgt = np.clip(np.minimum(cols + 0.5, b) - np.maximum(cols - 0.5, a), 0.0, 1.0).astype(np.float32)
-    if wgt.sum() <= 0:
-        return None
-    wgt *= len(wgt) / wgt.sum()
-    er, eb = er * wgt, eb * wgt
+    return x0, y0, x1, y1, step, a, b
+
+
+def measure_rows_all(
+    bgr: np.ndarray, cands: Sequence[Candidate], gains: Gains, geometry: LandmarkGeometry,
+    xs_px: Sequence[Optional[float]],
+) -> List[Optional[Rows]]:
+    """:func:`measure_rows` of every candidate of a frame (``xs_px``: each one's ``x_px``).
+
+    The candidates' tiles are stacked one below the other, so the conversion to
+    linear-light excess and the column weighting run once for all of them; each
+    band's rows are then found on its own tile's profile, as for one candidate.
+    """
+    wins = [_row_window(bgr.shape, c, geometry, x) for c, x in zip(cands, xs_px)]
+    tiles, weights = [], []
+    for k, win in enumerate(wins):
+        if win is None:
+            continue
+        x0, y0, x1, y1, step, a, b = win
+        tile = bgr[y0:y1, x0:x1:step]
+        # end columns count by the share of them inside [a, b]: the profile moves smoothly with x
+        cols = x0 + step * np.arange(tile.shape[1])
+        wgt = np.clip(np.minimum(cols + 0.5, b) - np.maximum(cols - 0.5, a), 0.0, 1.0).astype(np.float32)
+        if wgt.sum() <= 0:
+            wins[k] = None
+            continue
+        wgt *= len(wgt) / wgt.sum()
+        tiles.append(tile)
+        weights.append(wgt)
+    if not tiles:
+        return [None] * len(cands)
+    offs = np.cumsum([0] + [t.shape[0] for t in tiles]).tolist()
+    stack = np.zeros((offs[-1], max(t.shape[1] for t in tiles), 3), np.uint8)
+    wst = np.zeros(stack.shape[:2], np.float32)
+    for o, tile, wgt in zip(offs, tiles, weights):
+        stack[o : o + tile.shape[0], : tile.shape[1]] = tile
+        wst[o : o + tile.shape[0], : tile.shape[1]] = wgt
+    er_all, eb_all = excess(stack, gains)
+    er_all *= wst
+    eb_all *= wst
+    out: List[Optional[Rows]] = []
+    j = 0
+    for c, win in zip(cands, wins):
+        if win is None:
+            out.append(None)
+            continue
+        o, n, m = offs[j], tiles[j].shape[0], tiles[j].shape[1]
+        out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m]))
+        j += 1
+    return out
+
+
+def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb: np.ndarray) -> Optional[Rows]:
+    """A candidate's :class:`Rows` from its weighted excess tiles (``oy``: the tiles' first frame row)."""
+    white_m = geometry.height_m - 2 * geometry.band_height_m
+    band_px = c.white_px * geometry.band_height_m / white_m
+    f = 1
+    ry, rh = c.red_bbox_px[1], c.red_bbox_px[3]
+    by, bh = c.blue_bbox_px[1], c.blue_bbox_px[3]
     hb, hw = band_px / f, c.white_px / f
     r_exp = (ry + 0.5 * rh - oy) / f - 0.5
     b_exp = (by + 0.5 * bh - oy) / f - 0.5

@@ -12,13 +12,14 @@ frame next.
 from __future__ import annotations
 
 import dataclasses
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from .color import Gains
 from .detect import BandCentroids, combine
+from .measure import measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
@@ -74,19 +75,28 @@ def advance(old: Track, now: BandCentroids) -> Track:
     return Track(now, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
 
 
-def remeasure(
-    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry,
-    fy_px: float,
-) -> Optional[BandCentroids]:
-    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments."""
+def _moved_bands(old: BandCentroids, red: BandFix, blue: BandFix) -> Tuple[BBox, BBox]:
+    """The old band boxes moved as the moments moved."""
     rdx, rdy = red.xy_px[0] - old.red_xy_px[0], red.xy_px[1] - old.red_xy_px[1]
     bdx, bdy = blue.xy_px[0] - old.blue_xy_px[0], blue.xy_px[1] - old.blue_xy_px[1]
-    rb, bb = _moved(old.red_bbox_px, rdx, rdy), _moved(old.blue_bbox_px, bdx, bdy)
+    return _moved(old.red_bbox_px, rdx, rdy), _moved(old.blue_bbox_px, bdx, bdy)
+
+
+def remeasure(
+    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry,
+    fy_px: float, rows: Any = None,
+) -> Optional[BandCentroids]:
+    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments.
+
+    ``rows``: ``(the moved candidate's measure_rows,)`` when measured already (:func:`step`
+    measures every track's rows at once).
+    """
+    rb, bb = _moved_bands(old, red, blue)
     if old.candidate is None:
         return dataclasses.replace(old, red_xy_px=red.xy_px, blue_xy_px=blue.xy_px, red_bbox_px=rb, blue_bbox_px=bb,
                                    red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
     cand = dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
-    now = combine(bgr, cand, red, blue, gains, geometry, fy_px)
+    now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, *(rows or ()))
     if now is None:
         return None
     return dataclasses.replace(now, red_chroma=old.red_chroma, blue_chroma=old.blue_chroma)
@@ -109,12 +119,22 @@ def step(
         refs.extend((t.bands.red_chroma, t.bands.blue_chroma))  # kept from the last full scan
     margins = [motion_margin(b) for b in boxes]
     fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), margins, cfg, gains, refs=refs)
+    ok = [red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)
+          for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])]
+    # every followed landmark's rows in one batch, in the boxes remeasure will move them to
+    moved = [(t, red, blue) for t, red, blue, k in zip(tracks, fixes[0::2], fixes[1::2], ok)
+             if k and t.bands.candidate is not None]
+    rows = iter(measure_rows_all(
+        bgr, [dataclasses.replace(t.bands.candidate, red_bbox_px=rb, blue_bbox_px=bb)
+              for t, red, blue in moved for rb, bb in [_moved_bands(t.bands, red, blue)]],
+        gains, geometry, [0.5 * (red.xy_px[0] + blue.xy_px[0]) for _, red, blue in moved]))
     kept: List[Track] = []
     lost = False
-    for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2]):
+    for t, red, blue, k in zip(tracks, fixes[0::2], fixes[1::2], ok):
         now = None
-        if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits):
-            now = remeasure(bgr, t.bands, red, blue, gains, geometry, fy_px)
+        if k:
+            pre = (next(rows),) if t.bands.candidate is not None else None
+            now = remeasure(bgr, t.bands, red, blue, gains, geometry, fy_px, pre)
         if now is None:
             lost = True
             continue
