@@ -93,7 +93,7 @@ def _row_window(shape: Tuple[int, ...], c: Candidate, geometry: LandmarkGeometry
     band_px = c.white_px * geometry.band_height_m / white_m
     rx, ry, rw, _ = c.red_bbox_px
     by, bh = c.blue_bbox_px[1], c.blue_bbox_px[3]
-    whole = cut_sides(c, bgr.shape[1]) == (False, False)
+    whole = cut_sides(c, shape[1]) == (False, False)
     a, b = (x_px - rw / 3, x_px + rw / 3) if x_px is not None and whole else (rx, rx + rw)
     cx0, cx1 = int(np.floor(a + 0.5)), int(np.ceil(b - 0.5)) + 1
     step = _step(cx1 - cx0)
