@@ -12,7 +12,7 @@ frame next.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -23,6 +23,7 @@ from .measure import measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
+from .structure import Candidate
 from .types import XY, BBox, LandmarkGeometry
 
 MASS_RATIO = (0.6, 1.6)  # a band's weight may change this much between frames
@@ -84,22 +85,25 @@ def _moved_bands(old: BandCentroids, red: BandFix, blue: BandFix) -> Tuple[BBox,
 
 def remeasure(
     bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry,
-    fy_px: float, rows: Any = None,
+    fy_px: float,
 ) -> Optional[BandCentroids]:
-    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments.
-
-    ``rows``: ``(the moved candidate's measure_rows,)`` when measured already (:func:`step`
-    measures every track's rows at once).
-    """
-    rb, bb = _moved_bands(old, red, blue)
+    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments."""
     if old.candidate is None:
-        return dataclasses.replace(old, red_xy_px=red.xy_px, blue_xy_px=blue.xy_px, red_bbox_px=rb, blue_bbox_px=bb,
-                                   red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
-    cand = dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
-    now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, *(rows or ()))
-    if now is None:
-        return None
-    return dataclasses.replace(now, red_chroma=old.red_chroma, blue_chroma=old.blue_chroma)
+        return _moved_only(old, red, blue)
+    cand = _moved_candidate(old, red, blue)
+    return combine(bgr, cand, red, blue, gains, geometry, fy_px)  # chroma refs: the ones measure_bands was given
+
+
+def _moved_only(old: BandCentroids, red: BandFix, blue: BandFix) -> BandCentroids:
+    """A track without a structure candidate (the paper's path): the moments moved, nothing re-measured."""
+    rb, bb = _moved_bands(old, red, blue)
+    return dataclasses.replace(old, red_xy_px=red.xy_px, blue_xy_px=blue.xy_px, red_bbox_px=rb, blue_bbox_px=bb,
+                               red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
+
+
+def _moved_candidate(old: BandCentroids, red: BandFix, blue: BandFix) -> Candidate:
+    rb, bb = _moved_bands(old, red, blue)
+    return dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
 
 
 def step(
@@ -111,7 +115,12 @@ def step(
     limits: PairingLimits,
     fy_px: float = 634.0,
 ) -> Tuple[List[Track], bool]:
-    """Follow every track into this frame; returns the surviving tracks and whether any was lost."""
+    """Follow every track into this frame; returns the surviving tracks and whether any was lost.
+
+    Each followed landmark is measured as :func:`remeasure` does, all of them in
+    one batch (:func:`.measure.measure_rows_all`). The bands' chroma references
+    are the ones kept from the last full scan: ``measure_bands`` returns them as given.
+    """
     boxes: List[BBox] = []
     refs: List[float] = []
     for t in tracks:
@@ -119,22 +128,20 @@ def step(
         refs.extend((t.bands.red_chroma, t.bands.blue_chroma))  # kept from the last full scan
     margins = [motion_margin(b) for b in boxes]
     fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), margins, cfg, gains, refs=refs)
-    ok = [red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)
-          for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])]
-    # every followed landmark's rows in one batch, in the boxes remeasure will move them to
-    moved = [(t, red, blue) for t, red, blue, k in zip(tracks, fixes[0::2], fixes[1::2], ok)
-             if k and t.bands.candidate is not None]
-    rows = iter(measure_rows_all(
-        bgr, [dataclasses.replace(t.bands.candidate, red_bbox_px=rb, blue_bbox_px=bb)
-              for t, red, blue in moved for rb, bb in [_moved_bands(t.bands, red, blue)]],
-        gains, geometry, [0.5 * (red.xy_px[0] + blue.xy_px[0]) for _, red, blue in moved]))
+    found = [(t, red, blue) for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])
+             if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
+    lost = len(found) < len(tracks)
+    cands = [_moved_candidate(t.bands, red, blue) if t.bands.candidate is not None else None for t, red, blue in found]
+    with_cand = [k for k, c in enumerate(cands) if c is not None]
+    rows = measure_rows_all(bgr, [cands[k] for k in with_cand], gains, geometry,
+                            [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand])
+    row_of = dict(zip(with_cand, rows))
     kept: List[Track] = []
-    lost = False
-    for t, red, blue, k in zip(tracks, fixes[0::2], fixes[1::2], ok):
-        now = None
-        if k:
-            pre = (next(rows),) if t.bands.candidate is not None else None
-            now = remeasure(bgr, t.bands, red, blue, gains, geometry, fy_px, pre)
+    for k, ((t, red, blue), cand) in enumerate(zip(found, cands)):
+        if cand is None:
+            now: Optional[BandCentroids] = _moved_only(t.bands, red, blue)
+        else:
+            now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, row_of[k])
         if now is None:
             lost = True
             continue
