@@ -10,6 +10,7 @@ import pytest
 
 from rangebearing.config import Config, check, load_config
 from rangebearing.errors import ConfigError
+from rangebearing.net.fit import landmarks_that_fit
 
 BOMB = "\n".join(
     ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
@@ -150,7 +151,7 @@ def test_yaml_syntax_errors_name_the_file_and_line(tmp_path: Path) -> None:
     ('publish: {robot_id: "zumo 7"}\n', "publish.robot_id"),
     ('publish: {robot_id: "\\ud800"}\n', "publish.robot_id"),
     ('publish: {robot_id: "a\\nb"}\n', "publish.robot_id"),
-    ("detection: {max_landmarks: 1000}\n", "detection.max_landmarks: 1000 landmarks make datagrams of up to"),
+    ("detection: {max_landmarks: 1000}\n", "detection.max_landmarks: must be an integer from 1 to 64, got 1000"),
     ("publish: {unicast: [" + ", ".join(f'"127.0.0.1:{p}"' for p in range(1, 2000)) + "]}\n",
      "publish.unicast: 1999 entries; at most 32"),
     ("source: {timeout_s: 4, retries: 10}\n", "source.timeout_s × source.retries: 40 s"),
@@ -161,12 +162,13 @@ def test_check_refuses_what_can_never_publish(tmp_path: Path, text: str, says: s
     assert says in str(_load(tmp_path, text))
 
 
-def test_max_landmarks_message_says_how_many_fit(tmp_path: Path) -> None:
-    err = _load(tmp_path, "detection: {max_landmarks: 40}\n")
-    fit = int(str(err).split("at most ")[1].split()[0])
+def test_max_landmarks_is_not_bounded_by_the_datagram(tmp_path: Path) -> None:
+    """More landmarks than one packet holds are detected and tracked; the wire sends the nearest that fit."""
+    fit = landmarks_that_fit("zumo")
     f = tmp_path / "ok.yaml"
-    f.write_text(f"detection: {{max_landmarks: {fit}}}\n")
-    assert load_config(f).detection.max_landmarks == fit
+    f.write_text(f"detection: {{max_landmarks: {2 * fit}}}\n")
+    assert load_config(f).detection.max_landmarks == 2 * fit
+    assert Config().detection.max_landmarks > fit  # the default detects a crowd larger than one packet holds
 
 
 def test_the_defaults_pass_their_own_checks() -> None:

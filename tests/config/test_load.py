@@ -35,10 +35,11 @@ def load_config_text(text):
     return config_from_mapping(yaml.safe_load(text))
 
 
+SECTIONS = ("camera", "landmark", "detection", "model", "identity", "source", "publish", "daemon")
+
+
 def dataclass_equal(a, b):
-    return {k: getattr(a, k) for k in ("camera", "landmark", "detection", "model", "source", "publish", "daemon")} == {
-        k: getattr(b, k) for k in ("camera", "landmark", "detection", "model", "source", "publish", "daemon")
-    }
+    return {k: getattr(a, k) for k in SECTIONS} == {k: getattr(b, k) for k in SECTIONS}
 
 
 def test_every_problem_is_named_at_once(tmp_path):

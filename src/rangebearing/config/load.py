@@ -113,6 +113,7 @@ def _cross_checks(cfg: Config) -> list[str]:
         p.append(f"source.timeout_s × source.retries: {budget_s:g} s without a frame before the daemon gives up; "
                  f"at most {MAX_CAPTURE_BUDGET_S:g} s, clearly inside the service's WatchdogSec=20s")
     p.extend(_datagram_fits(cfg))
+    p.extend(_identity_checks(cfg))
     z = cfg.publish.zenoh
     if z.enabled and z.mode == "client" and not z.connect:
         p.append("publish.zenoh.connect: client mode needs a router (or peer) endpoint to connect to")
@@ -120,17 +121,31 @@ def _cross_checks(cfg: Config) -> list[str]:
 
 
 def _datagram_fits(cfg: Config) -> list[str]:
-    """A frame with ``max_landmarks`` landmarks must fit one packet (else fewer are sent, flagged)."""
-    from ..net.fit import MTU_PAYLOAD_BYTES, landmarks_that_fit, worst_case_bytes  # net imports config
+    """At least one landmark must fit one packet (``max_landmarks`` need not: the nearest that fit are sent)."""
+    from ..net.fit import MTU_PAYLOAD_BYTES, landmarks_that_fit  # net imports config
 
-    n, robot = cfg.detection.max_landmarks, cfg.publish.robot_id
-    size = worst_case_bytes(robot, n, cfg.camera.width_px, cfg.camera.height_px)
-    if size <= MTU_PAYLOAD_BYTES:
+    if landmarks_that_fit(cfg.publish.robot_id, cfg.camera.width_px, cfg.camera.height_px) > 0:
         return []
-    fit = landmarks_that_fit(robot, cfg.camera.width_px, cfg.camera.height_px)
-    return [f"detection.max_landmarks: {n} landmarks make datagrams of up to {size:,} bytes, over the "
-            f"{MTU_PAYLOAD_BYTES:,}-byte limit of one unfragmented packet; at most {fit} fit"
-            + (f" with robot_id {robot!r}" if len(robot) > 8 else "")]
+    return [f"publish.robot_id: with {cfg.publish.robot_id!r} and a {cfg.camera.width_px}x{cfg.camera.height_px} "
+            f"camera not even one landmark fits the {MTU_PAYLOAD_BYTES:,}-byte limit of one unfragmented packet"]
+
+
+def _identity_checks(cfg: Config) -> list[str]:
+    """Settings of the track-id filter that are each valid but contradict one another."""
+    idp, p = cfg.identity, []
+    if idp.max_hidden_young_frames > idp.max_hidden_frames:
+        p.append(f"identity.max_hidden_young_frames: {idp.max_hidden_young_frames} is more than "
+                 f"identity.max_hidden_frames {idp.max_hidden_frames} (a glimpse would outlive a track)")
+    if idp.max_dt_s < idp.nominal_dt_s:
+        p.append(f"identity.max_dt_s: {idp.max_dt_s:g} s is less than identity.nominal_dt_s {idp.nominal_dt_s:g} s")
+    if idp.outlier_range_frac < idp.min_range_sigma_frac:
+        p.append(f"identity.outlier_range_frac: {idp.outlier_range_frac:g} is less than identity.min_range_sigma_frac "
+                 f"{idp.min_range_sigma_frac:g} (the outlier component must be the wider one)")
+    if idp.outlier_bearing_rad < idp.min_bearing_sigma_rad:
+        p.append(f"identity.outlier_bearing_rad: {idp.outlier_bearing_rad:g} is less than "
+                 f"identity.min_bearing_sigma_rad {idp.min_bearing_sigma_rad:g} (the outlier component must be "
+                 "the wider one)")
+    return p
 
 
 def load_config(path: Union[str, Path, None] = None) -> Config:

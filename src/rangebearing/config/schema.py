@@ -1,8 +1,9 @@
 """The configuration's shape: one frozen dataclass per YAML section, and the per-key checks.
 
-The four sections the pipeline needs (camera, landmark, detection, model) are
-the core's own parameter types (:mod:`rangebearing.core.params`); the rest
-(source, publish, daemon) belong to the application shell.
+The five sections the pipeline needs (camera, landmark, detection, model,
+identity) are the core's own parameter types (:mod:`rangebearing.core.params`,
+:class:`~rangebearing.core.identity.IdentityParams`); the rest (source,
+publish, daemon) belong to the application shell.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import math
 from typing import Any, Dict, Tuple
 
 from .._compat import frozen
+from ..core.identity import IdentityParams
 from ..core.params import METHODS, MODELS, WHITE_BALANCE, DetectionParams, ModelParams, PipelineParams
 from ..core.types import CameraIntrinsics, LandmarkGeometry
 from . import checks as ck
@@ -20,6 +22,9 @@ SOURCES = ("recorded", "opencv", "picamera2", "synthetic")
 # No frame for timeout_s × retries seconds: the daemon reopens the camera halfway, then exits
 # cleanly for systemd to restart it, always before the unit's WatchdogSec=20s would SIGABRT it.
 MAX_CAPTURE_BUDGET_S = 12.0
+# detection.max_landmarks bounds a frame's search (its cost grows with it), not the datagram: the wire
+# sends the nearest that fit one packet and counts the rest (net/fit.py)
+MAX_LANDMARKS = 64
 
 
 @frozen
@@ -88,6 +93,7 @@ class Config:
     landmark: LandmarkGeometry = LandmarkGeometry()
     detection: DetectionParams = DetectionParams()
     model: ModelParams = ModelParams()
+    identity: IdentityParams = IdentityParams()
     source: SourceConfig = SourceConfig()
     publish: PublishConfig = PublishConfig()
     daemon: DaemonConfig = DaemonConfig()
@@ -95,8 +101,8 @@ class Config:
 
     @property
     def pipeline(self) -> PipelineParams:
-        """What the pipeline needs: camera, landmark, detection and model."""
-        return PipelineParams(self.camera, self.landmark, self.detection, self.model)
+        """What the pipeline needs: camera, landmark, detection, model and identity."""
+        return PipelineParams(self.camera, self.landmark, self.detection, self.model, self.identity)
 
 
 SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
@@ -132,7 +138,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "s_min": ck.number(0, 255, integer=True),
             "v_min": ck.number(0, 255, integer=True),
             "min_band_px": ck.number(1, 100),
-            "max_landmarks": ck.positive(True),
+            "max_landmarks": ck.number(1, MAX_LANDMARKS, integer=True),
             "tracking": ck.boolean,
             "full_scan_every": ck.positive(True),
         },
@@ -148,6 +154,29 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "cylinder_correction": ck.boolean,
             "envelope_range_m": ck.pair(0, 100),
             "envelope_bearing_rad": ck.pair(-math.pi, math.pi),
+        },
+    ),
+    "identity": (
+        IdentityParams,
+        {
+            "max_hidden_frames": ck.number(0, 1000, integer=True),
+            "max_hidden_young_frames": ck.number(0, 1000, integer=True),
+            "gate_d2": ck.number(above=0, hi=1000),
+            "range_accel_mps2": ck.number(above=0, hi=100),
+            "lateral_accel_mps2": ck.number(above=0, hi=100),
+            "yaw_accel_radps2": ck.number(0, 100),
+            "range_rate_prior_mps": ck.number(above=0, hi=100),
+            "bearing_rate_prior_radps": ck.number(above=0, hi=100),
+            "min_range_sigma_frac": ck.number(above=0, hi=1),
+            "min_bearing_sigma_rad": ck.number(above=0, hi=1),
+            "outlier_fraction": ck.number(above=0, hi=0.5),
+            "outlier_range_frac": ck.number(above=0, hi=1),
+            "outlier_bearing_rad": ck.number(above=0, hi=1),
+            "young_penalty": ck.number(0, 1000),
+            "twin_width_m": ck.number(0, 1),
+            "nominal_dt_s": ck.number(above=0, hi=10),
+            "max_dt_s": ck.number(above=0, hi=3600),
+            "rate_after_updates": ck.number(2, 1000, integer=True),
         },
     ),
     "source": (

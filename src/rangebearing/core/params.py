@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import Tuple
 
 from .._compat import frozen
+from .identity import IdentityParams
 from .types import CameraIntrinsics, LandmarkGeometry
 
 METHODS = ("fast", "paper")
@@ -31,7 +32,9 @@ class DetectionParams:
     s_min: int = 90
     v_min: int = 25
     min_band_px: float = 3.0
-    max_landmarks: int = 8  # the most whose datagram always fits one packet (run --check enforces it)
+    # the most landmarks a frame can yield (detected, measured, tracked); the wire sends the nearest that
+    # fit one datagram and counts the rest (net/fit.py), so this is not bounded by the packet size
+    max_landmarks: int = 16
     tracking: bool = True
     full_scan_every: int = 8
 
@@ -58,9 +61,10 @@ class ModelParams:
 
 @frozen
 class PipelineParams:
-    """The camera, the landmark, how bands are found and how they become range and bearing."""
+    """The camera, the landmark, how bands are found, how they become range and bearing, and track ids."""
 
     camera: CameraIntrinsics = CameraIntrinsics()
     landmark: LandmarkGeometry = LandmarkGeometry()
     detection: DetectionParams = DetectionParams()
     model: ModelParams = ModelParams()
+    identity: IdentityParams = IdentityParams()

@@ -152,7 +152,7 @@ class Pipeline:
         # the identity filter's own call (identify() would build every Landmark a second time to add the ids)
         self._identity, out = update(
             self._identity, [r[0] for r in readings], [r[1] for r in readings], [r[10] for r in readings],
-            [r[11] for r in readings], t_s, None, [r[12] for r in readings],
+            [r[11] for r in readings], t_s, self.params.identity, [r[12] for r in readings],
         )
         landmarks = tuple(
             Landmark(*r, int(tid), None if rr != rr else float(rr), None if br != br else float(br))  # NaN: no rate yet

@@ -2,9 +2,9 @@
 
 A datagram larger than :data:`MTU_PAYLOAD_BYTES` would be fragmented by IP (one
 lost fragment loses the reading) and one over 65,507 bytes cannot be sent at
-all. ``--check`` refuses a ``max_landmarks`` whose full datagram could be too
-large; this is the safety net for the frame that still is (an unusually long
-number, a bigger camera): it is sent with fewer landmarks, never not at all.
+all. Detection is bounded by ``detection.max_landmarks`` (16), not by the
+packet: up to 8 landmarks always fit (:func:`landmarks_that_fit`), typically
+10; a frame with more is sent with the nearest that fit, never not at all.
 """
 
 from __future__ import annotations
