@@ -26,14 +26,16 @@ returns a new one and never reads a clock.
 
 from __future__ import annotations
 
-from dataclasses import replace
+import operator
+from dataclasses import fields
+from functools import lru_cache
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from .assignment import assign_gated
-from .kalman import BEARING, RANGE, correct, distances, measurement_variance, predict
+from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, distances, measurement_variance, predict
 from .types import Landmark
 
 
@@ -79,20 +81,28 @@ class IdentityParams:
 DEFAULT_PARAMS = IdentityParams()
 
 
+@lru_cache(maxsize=8)
+def _log_weights(outlier_fraction: float) -> np.ndarray:
+    """``(2, 1, 1)`` log prior weights of a reading as its sigmas say and of an outlier (read-only)."""
+    w = np.array([np.log1p(-outlier_fraction), np.log(outlier_fraction)]).reshape(2, 1, 1)
+    w.flags.writeable = False
+    return w
+
+
 @frozen
 class IdentityState:
     """Every live track, as arrays over tracks (``n`` rows), and the id counter.
 
-    ``x`` is ``(n, 2, 2)``: channel (range, bearing) × (value, rate) in metres,
-    m/s, radians, rad/s. ``p`` is ``(n, 2, 3)``: per channel the covariance
-    entries ``(var value, cov value-rate, var rate)``. ``hidden`` counts the
+    ``s`` is ``(n, 2, 5)``, the packed filter state of :mod:`~rangebearing.core.kalman`:
+    per channel (range, bearing) the value and rate (metres, m/s, radians,
+    rad/s) and the covariance entries (var value, cov value-rate, var rate);
+    :attr:`x` and :attr:`p` are views of its two parts. ``hidden`` counts the
     frames since a track was last measured, ``updates`` its measurements.
     Treat the arrays as read-only.
     """
 
     ids: np.ndarray  # (n,) int64
-    x: np.ndarray
-    p: np.ndarray
+    s: np.ndarray  # (n, 2, 5) float
     hidden: np.ndarray  # (n,) int64
     updates: np.ndarray  # (n,) int64
     next_id: int = 0
@@ -102,11 +112,21 @@ class IdentityState:
     def size(self) -> int:
         return int(self.ids.shape[0])
 
+    @property
+    def x(self) -> np.ndarray:
+        """``(n, 2, 2)``: channel × (value, rate)."""
+        return self.s[:, :, VALUE:P00]
+
+    @property
+    def p(self) -> np.ndarray:
+        """``(n, 2, 3)``: channel × (var value, cov value-rate, var rate)."""
+        return self.s[:, :, P00:]
+
 
 def empty_state(first_id: int = 0) -> IdentityState:
     """No tracks; the next new track gets ``first_id``."""
     z = np.zeros(0, dtype=np.int64)
-    return IdentityState(z, np.zeros((0, 2, 2)), np.zeros((0, 2, 3)), z, z, first_id, None)
+    return IdentityState(z, np.zeros((0, 2, 5)), z, z, first_id, None)
 
 
 @frozen
@@ -147,14 +167,20 @@ def _twins(det_row: np.ndarray, z: np.ndarray, cols: np.ndarray, params: Identit
 def _births(state: IdentityState, z: np.ndarray, r: np.ndarray, params: IdentityParams) -> IdentityState:
     """New tracks for readings ``z`` (``(k, 2)``), ids from the counter on."""
     k = z.shape[0]
-    x0 = np.zeros((k, 2, 2))
-    x0[:, :, 0] = z
-    p0 = np.zeros((k, 2, 3))
-    p0[:, :, 0] = r
-    p0[:, RANGE, 2] = params.range_rate_prior_mps**2
-    p0[:, BEARING, 2] = params.bearing_rate_prior_radps**2
+    s0 = np.zeros((k, 2, 5))
+    s0[:, :, VALUE] = z
+    s0[:, :, P00] = r
+    s0[:, RANGE, P11] = params.range_rate_prior_mps**2
+    s0[:, BEARING, P11] = params.bearing_rate_prior_radps**2
     n = np.zeros(k, dtype=np.int64)
-    return IdentityState(state.next_id + np.arange(k, dtype=np.int64), x0, p0, n, n + 1, state.next_id + k)
+    return IdentityState(state.next_id + np.arange(k, dtype=np.int64), s0, n, n + 1, state.next_id + k)
+
+
+def _identified(ids: np.ndarray, s: np.ndarray, updates: np.ndarray, det_row: np.ndarray,
+                params: IdentityParams) -> Identified:
+    grown = updates[det_row] >= params.rate_after_updates
+    rates = np.where(grown[:, None], s[det_row, :, RATE], np.nan)
+    return Identified(track_id=ids[det_row], range_rate_mps=rates[:, RANGE], bearing_rate_radps=rates[:, BEARING])
 
 
 def update(
@@ -191,57 +217,79 @@ def update(
         Per reading, in input order: its track id (>= 0) and the filtered
         range and bearing rates, NaN until the track has
         ``params.rate_after_updates`` measurements.
+
+    Notes
+    -----
+    The cost is numpy call overhead (a few microseconds a call at these
+    sizes), so the common cases take short cuts that give the same result:
+    no tracks or no readings skip the association, and when no two gates
+    overlap (every gated track has one gated reading and vice versa) the
+    pairs are taken without computing the assignment cost.
     """
-    m = len(range_m)
-    z = np.empty((m, 2))
-    z[:, RANGE] = range_m
-    z[:, BEARING] = bearing_rad
     params = DEFAULT_PARAMS if params is None else params
-    seen = np.ones(m) if visible is None else np.asarray(visible, float)
-    r = measurement_variance(z[:, RANGE], np.asarray(range_sigma_m, float), np.asarray(bearing_sigma_rad, float),
-                             seen, params)
-    x, p = predict(state.x, state.p, _dt(state, t_s, params), params)
-    rw = np.maximum(r, np.square(np.stack([params.outlier_range_frac * z[:, RANGE],
-                                           np.full(m, params.outlier_bearing_rad)], axis=1)))
-    d2, nll = distances(x, p, z, r)
-    d2w, nllw = distances(x, p, z, rw)
-    good = np.log1p(-params.outlier_fraction) - 0.5 * nll  # log-likelihoods of the two kinds of reading
-    bad = np.log(params.outlier_fraction) - 0.5 * nllw
-    established = state.updates >= params.rate_after_updates  # only a track with a motion takes outliers
-    gated = (d2 <= params.gate_d2) | ((d2w <= params.gate_d2) & established[:, None])
-    cost = -2.0 * np.logaddexp(good, bad) + np.where(established, 0.0, params.young_penalty)[:, None]
-    rows, cols = assign_gated(np.where(gated, cost, np.inf), np.inf)
+    m, n = len(range_m), state.size
+    s = predict(state.s, _dt(state, t_s, params), params) if n else state.s
     hidden = state.hidden + 1
-    updates = state.updates.copy()
-    if rows.size:
-        outlier = (bad > good)[rows, cols]
-        x[rows], p[rows] = correct(x[rows], p[rows], z[cols], np.where(outlier[:, None], rw[cols], r[cols]))
-        hidden[rows] = 0
-        updates[rows] += 1
-    ids, next_id = state.ids, state.next_id
+    updates, ids, next_id = state.updates, state.ids, state.next_id
     det_row = np.full(m, -1, dtype=np.intp)
-    det_row[cols] = rows
-    if 0 < rows.size < m:
-        _twins(det_row, z, cols, params)
-    if (det_row < 0).any():  # readings no track took: new tracks, appended after the old ones
+    if m:
+        z = np.empty((m, 2))
+        z[:, RANGE] = range_m
+        z[:, BEARING] = bearing_rad
+        r = measurement_variance(z[:, RANGE], np.asarray(range_sigma_m, float),
+                                 np.asarray(bearing_sigma_rad, float),
+                                 None if visible is None else np.asarray(visible, float), params)
+    if m and n:
+        rows, cols, noise = _associate(state, s, z, r, params)
+        if rows.size:
+            s[rows] = correct(s[rows], z[cols], noise)
+            hidden[rows] = 0
+            updates = updates.copy()
+            updates[rows] += 1
+            det_row[cols] = rows
+            if rows.size < m:
+                _twins(det_row, z, cols, params)
+    if m and (det_row < 0).any():  # readings no track took: new tracks, appended after the old ones
         new = np.nonzero(det_row < 0)[0]
         born = _births(state, z[new], r[new], params)
-        det_row[new] = ids.shape[0] + np.arange(new.size)
+        det_row[new] = n + np.arange(new.size)
         ids, next_id = np.concatenate([ids, born.ids]), born.next_id
-        x, p = np.concatenate([x, born.x]), np.concatenate([p, born.p])
+        s = np.concatenate([s, born.s])
         hidden, updates = np.concatenate([hidden, born.hidden]), np.concatenate([updates, born.updates])
-    grown = updates[det_row] >= params.rate_after_updates
-    rates = x[det_row, :, 1]
-    identified = Identified(
-        track_id=ids[det_row],
-        range_rate_mps=np.where(grown, rates[:, RANGE], np.nan),
-        bearing_rate_radps=np.where(grown, rates[:, BEARING], np.nan),
-    )
-    limit = np.where(updates >= 2, params.max_hidden_frames, params.max_hidden_young_frames)
-    keep = hidden <= limit
-    if not keep.all():
-        ids, x, p, hidden, updates = ids[keep], x[keep], p[keep], hidden[keep], updates[keep]
-    return IdentityState(ids, x, p, hidden, updates, next_id, t_s), identified
+    identified = _identified(ids, s, updates, det_row, params)
+    if hidden.size and hidden.max() > min(params.max_hidden_frames, params.max_hidden_young_frames):
+        keep = hidden <= np.where(updates >= 2, params.max_hidden_frames, params.max_hidden_young_frames)
+        if not keep.all():
+            ids, s, hidden, updates = ids[keep], s[keep], hidden[keep], updates[keep]
+    return IdentityState(ids, s, hidden, updates, next_id, t_s), identified
+
+
+def _associate(state: IdentityState, s: np.ndarray, z: np.ndarray, r: np.ndarray,
+               params: IdentityParams) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Matched (track rows, reading columns) and the noise each matched reading updates its track with."""
+    noise = np.empty((2, *z.shape))  # (2, m, 2): as the sigmas say, and as an outlier
+    noise[0] = r
+    np.square(params.outlier_range_frac * z[:, RANGE], out=noise[1, :, RANGE])
+    noise[1, :, BEARING] = params.outlier_bearing_rad**2
+    np.maximum(r, noise[1], out=noise[1])
+    d2, nll = distances(s, z, noise)  # (2, n, m) each
+    loglik = _log_weights(params.outlier_fraction) - 0.5 * nll  # of the two kinds of reading
+    inside = d2 <= params.gate_d2
+    established = state.updates >= params.rate_after_updates  # only a track with a motion takes outliers
+    gated = inside[0] | (inside[1] & established[:, None])
+    rows, cols = np.nonzero(gated)
+    k = rows.size
+    if k > 1 and (len(set(rows.tolist())) < k or len(set(cols.tolist())) < k):  # gates overlap: choose
+        cost = -2.0 * np.logaddexp(loglik[0], loglik[1]) + np.where(established, 0.0, params.young_penalty)[:, None]
+        rows, cols = assign_gated(np.where(gated, cost, np.inf), np.inf)
+    both = loglik[:, rows, cols]
+    return rows, cols, noise[(both[1] > both[0]).astype(np.intp), cols]
+
+
+_MEASURED = operator.attrgetter("range_m", "bearing_rad", "range_sigma_m", "bearing_sigma_rad", "visible")
+_FIELDS = tuple(f.name for f in fields(Landmark))
+_ALL = operator.attrgetter(*_FIELDS)
+_TRACK, _RANGE_RATE, _BEARING_RATE = (_FIELDS.index(k) for k in ("track_id", "range_rate_mps", "bearing_rate_radps"))
 
 
 def identify(
@@ -253,20 +301,17 @@ def identify(
     The measured fields (``range_m``, ``bearing_rad``, the sigmas, …) are
     copied unchanged: the filter only adds rates.
     """
-    state, out = update(
-        state,
-        [lm.range_m for lm in landmarks],
-        [lm.bearing_rad for lm in landmarks],
-        [lm.range_sigma_m for lm in landmarks],
-        [lm.bearing_sigma_rad for lm in landmarks],
-        t_s,
-        params,
-        [lm.visible for lm in landmarks],
-    )
-    labelled = tuple(
-        replace(lm, track_id=int(tid), range_rate_mps=None if rr != rr else float(rr),
-                bearing_rate_radps=None if br != br else float(br))  # NaN (no history yet) -> None
-        for lm, tid, rr, br in zip(landmarks, out.track_id.tolist(), out.range_rate_mps.tolist(),
-                                   out.bearing_rate_radps.tolist())
-    )
-    return state, labelled
+    if landmarks:
+        cols = np.array([_MEASURED(lm) for lm in landmarks], dtype=float).T
+        state, out = update(state, cols[0], cols[1], cols[2], cols[3], t_s, params, cols[4])
+    else:
+        state, out = update(state, (), (), (), (), t_s, params)
+    labelled = []
+    for lm, tid, rr, br in zip(landmarks, out.track_id.tolist(), out.range_rate_mps.tolist(),
+                               out.bearing_rate_radps.tolist()):
+        values = list(_ALL(lm))  # a copy with three fields changed, without dataclasses.replace's cost
+        values[_TRACK] = tid
+        values[_RANGE_RATE] = None if rr != rr else rr  # NaN (no history yet) -> None
+        values[_BEARING_RATE] = None if br != br else br
+        labelled.append(Landmark(*values))
+    return state, tuple(labelled)
