@@ -12,9 +12,11 @@ Each frame (:func:`update`):
 2. gate: squared Mahalanobis distance ``d²`` of each detection from each
    prediction, with the innovation covariance (prediction plus the reading's
    noise); pairs beyond ``gate_d2`` are never made;
-3. assign globally (:func:`~rangebearing.core.assignment.assign_gated`: the
+3. assign globally (:func:`~rangebearing.core.association.associate`: the
    most gated pairs, then the least total ``d² + ln det S``; a Hungarian
-   solver for overlapping gates), update the matched tracks;
+   solver for overlapping gates), update the matched tracks, except with a
+   reading of two landmarks merged in the image (it keeps its track alive
+   but moves it not);
 4. unmatched tracks coast; one unmatched for more than ``max_hidden_frames``
    frames in a row is dropped; each unmatched detection starts a track with
    the next id.
@@ -28,14 +30,13 @@ from __future__ import annotations
 
 import operator
 from dataclasses import fields
-from functools import lru_cache
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
-from .assignment import assign_gated
-from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, distances, measurement_variance, predict
+from .association import associate, twins
+from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, measurement_variance, predict
 from .types import Landmark
 
 
@@ -79,14 +80,6 @@ class IdentityParams:
 
 
 DEFAULT_PARAMS = IdentityParams()
-
-
-@lru_cache(maxsize=8)
-def _log_weights(outlier_fraction: float) -> np.ndarray:
-    """``(2, 1, 1)`` log prior weights of a reading as its sigmas say and of an outlier (read-only)."""
-    w = np.array([np.log1p(-outlier_fraction), np.log(outlier_fraction)]).reshape(2, 1, 1)
-    w.flags.writeable = False
-    return w
 
 
 @frozen
@@ -145,23 +138,6 @@ def _dt(state: IdentityState, t_s: Optional[float], params: IdentityParams) -> f
     if not dt > 0.0:  # a repeated or out-of-order stamp: assume the nominal interval
         return params.nominal_dt_s
     return min(dt, params.max_dt_s)
-
-
-def _twins(det_row: np.ndarray, z: np.ndarray, cols: np.ndarray, params: IdentityParams) -> None:
-    """Give a leftover reading that lies on a matched one (within a landmark's width in bearing
-    and ``outlier_range_frac`` in range: the same landmark, seen twice) that reading's track, in place.
-
-    A landmark split in two by the detector is then one neighbour, not a newcomer.
-    """
-    left = np.nonzero(det_row < 0)[0]
-    db = np.abs(z[left, None, BEARING] - z[None, cols, BEARING])
-    rng = z[cols, RANGE][None, :]
-    dr = np.abs(z[left, None, RANGE] - rng)
-    twin = (db <= params.twin_width_m / rng) & (dr <= params.outlier_range_frac * rng)
-    has = twin.any(axis=1)
-    if has.any():
-        nearest = np.argmin(np.where(twin, db, np.inf), axis=1)
-        det_row[left[has]] = det_row[cols[nearest[has]]]
 
 
 def _births(state: IdentityState, z: np.ndarray, r: np.ndarray, params: IdentityParams) -> IdentityState:
@@ -240,15 +216,20 @@ def update(
                                  np.asarray(bearing_sigma_rad, float),
                                  None if visible is None else np.asarray(visible, float), params)
     if m and n:
-        rows, cols, noise = _associate(state, s, z, r, params)
+        seen = np.ones(m) if visible is None else np.asarray(visible, float)
+        rows, cols, noise, trust = associate(s, state.updates, z, r, seen, params)
         if rows.size:
-            s[rows] = correct(s[rows], z[cols], noise)
+            if not trust.all():  # merged readings: the track is seen, but not moved
+                rows_t, cols_t, noise = rows[trust], cols[trust], noise[trust]
+            else:
+                rows_t, cols_t = rows, cols
+            s[rows_t] = correct(s[rows_t], z[cols_t], noise)
             hidden[rows] = 0
             updates = updates.copy()
             updates[rows] += 1
             det_row[cols] = rows
             if rows.size < m:
-                _twins(det_row, z, cols, params)
+                twins(det_row, z, cols, params)
     if m and (det_row < 0).any():  # readings no track took: new tracks, appended after the old ones
         new = np.nonzero(det_row < 0)[0]
         born = _births(state, z[new], r[new], params)
@@ -262,28 +243,6 @@ def update(
         if not keep.all():
             ids, s, hidden, updates = ids[keep], s[keep], hidden[keep], updates[keep]
     return IdentityState(ids, s, hidden, updates, next_id, t_s), identified
-
-
-def _associate(state: IdentityState, s: np.ndarray, z: np.ndarray, r: np.ndarray,
-               params: IdentityParams) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Matched (track rows, reading columns) and the noise each matched reading updates its track with."""
-    noise = np.empty((2, *z.shape))  # (2, m, 2): as the sigmas say, and as an outlier
-    noise[0] = r
-    np.square(params.outlier_range_frac * z[:, RANGE], out=noise[1, :, RANGE])
-    noise[1, :, BEARING] = params.outlier_bearing_rad**2
-    np.maximum(r, noise[1], out=noise[1])
-    d2, nll = distances(s, z, noise)  # (2, n, m) each
-    loglik = _log_weights(params.outlier_fraction) - 0.5 * nll  # of the two kinds of reading
-    inside = d2 <= params.gate_d2
-    established = state.updates >= params.rate_after_updates  # only a track with a motion takes outliers
-    gated = inside[0] | (inside[1] & established[:, None])
-    rows, cols = np.nonzero(gated)
-    k = rows.size
-    if k > 1 and (len(set(rows.tolist())) < k or len(set(cols.tolist())) < k):  # gates overlap: choose
-        cost = -2.0 * np.logaddexp(loglik[0], loglik[1]) + np.where(established, 0.0, params.young_penalty)[:, None]
-        rows, cols = assign_gated(np.where(gated, cost, np.inf), np.inf)
-    both = loglik[:, rows, cols]
-    return rows, cols, noise[(both[1] > both[0]).astype(np.intp), cols]
 
 
 _MEASURED = operator.attrgetter("range_m", "bearing_rad", "range_sigma_m", "bearing_sigma_rad", "visible")
