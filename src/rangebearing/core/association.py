@@ -28,13 +28,30 @@ def _log_weights(outlier_fraction: float) -> np.ndarray:
 
 def associate(s: np.ndarray, updates: np.ndarray, z: np.ndarray, r: np.ndarray, seen: np.ndarray,
               params: IdentityParams) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Pairs of predicted tracks ``s`` (``(n, 2, 5)``, ``updates`` readings each) and readings ``z``
-    (``(m, 2)``, variances ``r``, fraction ``seen``).
+    """Pair predicted tracks with a frame's readings.
 
-    Returns the matched track rows and reading columns, the noise each matched
-    reading updates its track with (its own, or the outlier sigmas when it is
-    more likely an outlier), and whether it may update it at all (False for a
-    merged reading, see below).
+    Parameters
+    ----------
+    s : numpy.ndarray
+        ``(n, 2, 5)`` packed predicted tracks (:mod:`~rangebearing.core.kalman`).
+    updates : numpy.ndarray
+        ``(n,)`` readings each track has had (a young track takes no outliers).
+    z, r : numpy.ndarray
+        ``(m, 2)`` readings (range m, bearing rad) and their variances.
+    seen : numpy.ndarray
+        ``(m,)`` fraction of each landmark seen (0-1).
+    params : IdentityParams
+
+    Returns
+    -------
+    rows, cols : numpy.ndarray
+        Matched track rows and reading columns (int, equal length ``k``).
+    noise : numpy.ndarray
+        ``(k, 2)`` variances each matched reading updates its track with: its
+        own, or the outlier ones when it is more likely an outlier.
+    trust : numpy.ndarray
+        ``(k,)`` bool: False for a merged reading (see below), which keeps its
+        track alive but must not move it.
     """
     noise = np.empty((2, *z.shape))  # (2, m, 2): as the sigmas say, and as an outlier
     noise[0] = r
