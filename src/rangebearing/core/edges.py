@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 from typing import Optional, Tuple
 
+import cv2
 import numpy as np
 
 from .._compat import frozen
@@ -38,8 +39,12 @@ def linear_table(gamma: float = GAMMA) -> np.ndarray:
 
 def excess(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray]:
     """Red and blue excess ``(H, W)`` float32 of a BGR uint8 tile, balanced, in linear light."""
-    lin = linear_table()[tile]
-    b, g, r = lin[..., 0] * gains[0], lin[..., 1] * gains[1], lin[..., 2] * gains[2]
+    if tile.size == 0 or tile.ndim != 3:
+        lin = linear_table()[tile]
+        b, g, r = lin[..., 0], lin[..., 1], lin[..., 2]
+    else:  # the same values: a table lookup and contiguous planes are several times cheaper than strided channels
+        b, g, r = cv2.split(cv2.LUT(tile, linear_table().reshape(256, 1)))
+    b, g, r = b * gains[0], g * gains[1], r * gains[2]
     return r - 0.5 * (g + b), b - 0.5 * (r + g)
 
 
