@@ -95,6 +95,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     from rangebearing.synth import PRESETS
 
     cv2.setNumThreads(1)
+    from rangebearing.allocator import keep_freed_buffers
+
+    keep_freed_buffers()  # as the daemon does (rangebearing run): no page faults for a frame's buffers
     plan = QUICK if args.quick else FULL
     repeats = args.repeats or plan["repeats"]
     passes = args.passes or plan["passes"]

@@ -9,6 +9,7 @@ import os
 import sys
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
+from ..allocator import keep_freed_buffers
 from ..config import Config, check
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
@@ -142,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
     echo = None
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
+    keep_freed_buffers()  # a frame's large buffers stay in the heap: no page faults for them every frame
     view = start_view_for(cfg, cfg.daemon.view_host, cfg.daemon.view_port, cfg.daemon.view_fps, args.config)
     recorder = None
     try:

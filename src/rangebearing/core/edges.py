@@ -43,7 +43,7 @@ def excess(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray]:
         lin = linear_table()[tile]
         b, g, r = lin[..., 0], lin[..., 1], lin[..., 2]
     else:  # the same values: a table lookup and contiguous planes are several times cheaper than strided channels
-        b, g, r = cv2.split(cv2.LUT(tile, linear_table().reshape(256, 1)))
+        b, g, r = np.ascontiguousarray(cv2.LUT(tile, linear_table().reshape(256, 1)).transpose(2, 0, 1))
     b, g, r = b * gains[0], g * gains[1], r * gains[2]
     return r - 0.5 * (g + b), b - 0.5 * (r + g)
 
