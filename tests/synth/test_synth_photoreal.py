@@ -9,7 +9,20 @@ import pytest
 
 from rangebearing.core.types import CameraIntrinsics
 from rangebearing.errors import SceneError
-from rangebearing.synth import Imaging, LandmarkPose, Lighting, Scene, isp, optics, random_scene, render
+from rangebearing.synth import (
+    Box,
+    Imaging,
+    LandmarkPose,
+    Lighting,
+    Scene,
+    bounce,
+    ground,
+    isp,
+    optics,
+    random_scene,
+    render,
+    surfaces,
+)
 from rangebearing.synth.photoreal import PHOTOREAL_PRESETS, defocus_px
 from rangebearing.synth.render import render_layers
 
@@ -110,15 +123,18 @@ def test_chroma_420_and_jpeg_keep_the_frame_shape():
 @pytest.mark.parametrize("preset", PHOTOREAL_PRESETS)
 def test_photoreal_presets_run_the_lens_and_isp_and_are_deterministic(preset):
     rng = np.random.default_rng(31)
-    scenes = [random_scene(rng, preset, SMALL) for _ in range(6)]
+    scenes = [random_scene(rng, preset, SMALL) for _ in range(4)]
     assert all(s.imaging.isp and s.imaging.focus_m >= 0.8 and s.imaging.ccm for s in scenes)
     assert all(lm.body is not None for s in scenes for lm in s.landmarks)
     near = [lm.range_m for s in scenes for lm in s.landmarks if defocus_px(s, lm.range_m) > 1.5]
     assert all(r < 0.5 for r in near)
     again = random_scene(np.random.default_rng(31), preset, SMALL)
     assert again == scenes[0]
-    a = render(scenes[0], np.random.default_rng(5))
-    assert a.shape == (240, 320, 3) and np.array_equal(a, render(again, np.random.default_rng(5)))
+    assert all(s.floor_shading and s.local_bounce for s in scenes)
+    tiny = CameraIntrinsics().scaled(160, 120)
+    one = random_scene(np.random.default_rng(32), preset, tiny)
+    a = render(one, np.random.default_rng(5))
+    assert a.shape == (120, 160, 3) and np.array_equal(a, render(one, np.random.default_rng(5)))
 
 
 def test_bad_isp_settings_are_named():
@@ -127,3 +143,84 @@ def test_bad_isp_settings_are_named():
     with pytest.raises(SceneError) as err:
         Scene(imaging=Imaging(demosaic="vng", jpeg_quality=120, ccm=(1.0,)))
     assert len(err.value.problems) == 3
+
+
+def _floor_row(scene: Scene, row: int) -> np.ndarray:
+    return render_layers(scene, supersample=1)[0][row]
+
+
+def test_an_object_shadows_the_floor_softly_and_darkens_its_base():
+    light = Lighting(direction=(-1.0, 1.0, 0.0), ambient=0.4, gloss=0.01)  # from the left, 45 deg up
+    box = Box(0.0, 0.5, 0.06, 0.06, 0.0, 0.06, (0.5, 0.5, 0.5))
+    base = Scene(camera=SMALL, boxes=(box,), lighting=light, wall_distance_m=None)
+    hard = dataclasses.replace(base, floor_shading=True)
+    soft = dataclasses.replace(hard, lighting=dataclasses.replace(light, light_radius_deg=12.0))
+    row = int(SMALL.cy_px + SMALL.fy_px * 0.1 / 0.47)  # the floor just in front of the box's base
+    plain, h, s = (_floor_row(sc, row)[:, 1] for sc in (base, hard, soft))
+    cx = int(SMALL.cx_px)
+    right = slice(cx + 30, cx + 60)  # the shadow falls to the right (+X is right in the image)
+    assert h[right].mean() < 0.75 * plain[right].mean()
+    assert 0.9 * plain[cx - 60:cx - 40].mean() < h[cx - 60:cx - 40].mean() < plain[cx - 60:cx - 40].mean()  # AO only
+    assert h[cx - 200:cx - 180].mean() == pytest.approx(plain[cx - 200:cx - 180].mean(), rel=5e-3)  # 0.3 m away
+    ramp = lambda v: int(((v > 1.02 * v.min()) & (v < 0.98 * v.max())).sum())  # noqa: E731
+    assert ramp(s[cx:cx + 150] / plain[cx:cx + 150]) > ramp(h[cx:cx + 150] / plain[cx:cx + 150]) + 3
+
+
+def test_ambient_occlusion_is_strongest_at_an_objects_base():
+    obj = ground.Standing(0.0, 1.0, 0.05, 0.05, (0.0, 0.0), np.ones((2, 2), np.float32))
+    pts = np.array([[0.06, 0.0, 1.0], [0.15, 0.0, 1.0], [0.6, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    occ = ground._occlusion(obj, pts)
+    assert occ[3] == 0.9 and 0.2 < occ[0] < 0.5 and occ[0] > occ[1] > occ[2] and occ[2] < 0.005
+
+
+def _sides(scene: Scene) -> tuple:
+    linear = render_layers(scene)[0]
+    rows = slice(int(SMALL.cy_px) - 4, int(SMALL.cy_px) + 4)  # white body, camera height
+    u = int(SMALL.cx_px)
+    left, right = linear[rows, u - 10:u - 7].mean(axis=(0, 1)), linear[rows, u + 7:u + 10].mean(axis=(0, 1))
+    return left, right
+
+
+def test_a_red_box_beside_a_landmark_tints_the_white_side_facing_it():
+    light = Lighting(ambient=0.6, direction=(0.0, 1.0, -0.2), gloss=0.01)
+    red = Box(-0.045, 0.5, 0.04, 0.06, 0.0, 0.2, (0.7, 0.05, 0.05))  # left of the landmark
+    scene = Scene(camera=SMALL, landmarks=(LandmarkPose(0.5, 0.0),), boxes=(red,), lighting=light)
+    left, right = _sides(dataclasses.replace(scene, local_bounce=True))
+    ref_l, ref_r = _sides(scene)
+    assert ref_l[0] / ref_l[1] == pytest.approx(ref_r[0] / ref_r[1], rel=0.01)
+    assert left[0] / left[1] > 1.05 * right[0] / right[1]  # pink on the box's side
+    assert left[1] < ref_l[1]  # less green light from there
+
+
+def test_a_dark_board_under_a_landmark_darkens_its_blue_band_more_than_its_red_band():
+    from rangebearing.synth.robots import zumo
+    lm = LandmarkPose(0.5, 0.0, body=zumo(np.random.default_rng(1)), heading_rad=1.0)
+    light = Lighting(ambient=0.8, direction=(0.0, 1.0, -0.3), gloss=0.01)
+    scene = Scene(camera=SMALL, landmarks=(lm,), lighting=light)
+    plain, near = render_layers(scene)[0], render_layers(dataclasses.replace(scene, local_bounce=True))[0]
+    u, f = int(SMALL.cx_px), SMALL.fy_px
+    blue = int(SMALL.cy_px + f * (0.1 - 0.0725) / 0.4825)
+    red = int(SMALL.cy_px - f * (0.1275 - 0.1) / 0.4825)
+    drop = lambda r: near[r, u].sum() / plain[r, u].sum()  # noqa: E731
+    assert drop(blue) < 0.97 and drop(blue) < drop(red) - 0.02
+
+
+def test_fresnel_mirrors_the_room_at_the_silhouette_only():
+    n = np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]])
+    r = bounce.fresnel(n, v)
+    assert r[0] == pytest.approx(0.04) and r[1] == pytest.approx(1.0)
+
+
+def test_seams_and_grout_are_anti_aliased_and_patterns_vary():
+    pos = np.linspace(0.0, 10.0, 20001)
+    cover = surfaces._line_cover(pos, 0.1, 0.002, np.full(pos.shape, 0.05))
+    assert cover.mean() == pytest.approx(0.02, rel=0.05) and cover.max() < 0.1  # footprint ≫ seam
+    sharp = surfaces._line_cover(pos, 0.1, 0.002, np.full(pos.shape, 1e-4))
+    assert sharp.max() == 1.0 and sharp.mean() == pytest.approx(0.02, rel=0.05)
+    rng = np.random.default_rng(4)
+    x, z = rng.uniform(-1, 1, 4000), rng.uniform(0.2, 2, 4000)
+    foot = np.full(x.shape, 5e-4)
+    for kind in surfaces.PATTERNS:
+        g = surfaces.floor_gain(x, z, foot, foot, kind, surfaces.params(rng, kind), 3)
+        assert g.shape == (4000, 3) and 0.05 < g[:, 1].std() < 0.5 and g.min() > 0.0

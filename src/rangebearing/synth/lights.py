@@ -11,11 +11,12 @@ floor and wall (:func:`bounce`), and needs each hit's normal and position.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Sequence, Tuple
+from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import shadows
+from . import bounce as local
+from . import ground, shadows
 from .scene import Scene
 from .shapes import Primitive
 
@@ -51,6 +52,9 @@ class Shader:
     casters: shadows.Casters = field(default_factory=shadows.empty_casters)
     bounce_up: np.ndarray = field(default_factory=lambda: np.ones(3))
     bounce_down: np.ndarray = field(default_factory=lambda: np.ones(3))
+    ground: Optional[ground.Ground] = None
+    nearby: Dict[int, local.Nearby] = field(default_factory=dict)
+    fresnel: float = 0.0
 
     @classmethod
     def from_scene(cls, scene: Scene, prims: Optional[Sequence[Primitive]] = None,
@@ -70,10 +74,17 @@ class Shader:
                          for s in li.spots]).reshape(-1, 2)
         cast = shadows.casters(prims, landmarks, light, pos) if prims is not None else {}
         up, down = bounce(scene)
+        floor = None
+        if scene.floor_shading and prims is not None:
+            objects = ground.standing(prims, ground.groups(len(prims), landmarks), light,
+                                      li.light_radius_deg)
+            floor = ground.Ground(objects, li.ambient * np.asarray(li.ambient_colour, float) * up,
+                                  (1.0 - li.ambient) * max(light[1], 0.0) * np.asarray(li.colour, float))
+        near = local.nearby(prims, landmarks, down) if scene.local_bounce and prims is not None else {}
         return cls(light, float(li.ambient), False, np.asarray(li.colour, float),
                    np.asarray(li.ambient_colour, float), pos, axis, power, cone,
                    float(li.gloss), float(li.shininess), (0.0, scene.camera_height_m, 0.0), cast,
-                   up, down)
+                   up, down, floor, near, float(li.fresnel))
 
     def __call__(self, albedo: np.ndarray, cos: np.ndarray) -> np.ndarray:
         """Plain Lambert: ``cos`` is n·l per hit; returns (..., 3) radiance."""
@@ -93,6 +104,8 @@ class Shader:
             direct = direct * shadows.lit(point, self.light, None, sun)
         w_up = 0.5 * (1.0 + normal[:, 1:2])
         room = w_up * self.bounce_up + (1.0 - w_up) * self.bounce_down
+        if owner is not None and owner in self.nearby:
+            room = room + local.room_change(self.nearby[owner], normal, point, self.bounce_down, room)
         irr = self.ambient * self.ambient_colour * room + direct[:, None] * self.colour
         spec = np.zeros(point.shape) if glossy and self.gloss > 0 else None
         view = None
@@ -124,4 +137,17 @@ class Shader:
         out = albedo * irr
         if spec is not None:
             out += self.gloss * spec
+        if glossy and self.fresnel > 0:
+            out = self._mirror(out, normal, point)
         return out
+
+    def _mirror(self, diffuse: np.ndarray, normal: np.ndarray, point: np.ndarray) -> np.ndarray:
+        """Glossy plastic: the room's radiance in the mirror direction, by Fresnel's share."""
+        view = np.asarray(self.eye) - point
+        view /= np.maximum(np.linalg.norm(view, axis=1, keepdims=True), 1e-12)
+        r = local.fresnel(normal, view)[:, None] * self.fresnel
+        refl_y = 2.0 * np.einsum("ij,ij->i", normal, view)[:, None] * normal[:, 1:2] - view[:, 1:2]
+        w = 0.5 * (1.0 + refl_y)
+        level = self.ambient * self.ambient_colour + 0.5 * (1.0 - self.ambient) * self.colour
+        room = local.ROOM_ALBEDO * level * (w * self.bounce_up + (1.0 - w) * self.bounce_down)
+        return (1.0 - r) * diffuse + r * room

@@ -26,7 +26,8 @@ fringes that grow towards the edges).
 from __future__ import annotations
 
 import functools
-from typing import Sequence, Tuple
+import math
+from typing import Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -85,39 +86,63 @@ def defocus(linear: np.ndarray, depth_m: np.ndarray, focus_m: float, aperture_m:
         i, w = _split(cc, LEVELS_PX)
         used = np.unique(i[mask]).tolist()
         for lv in (used if sign < 0 else used[::-1]):  # far side: the biggest blur is farthest
-            share = (mask & (i == lv)).astype(np.float32)
-            hi = share * w.astype(np.float32)
-            alpha, col = np.zeros_like(share), np.zeros_like(img)
+            layer = mask & (i == lv)
+            crop = _crop(layer, LEVELS_PX[lv + 1])
+            if crop is None:
+                continue
+            share = layer[crop].astype(np.float32)
+            hi = share * w[crop].astype(np.float32)
+            sub = img[crop]
+            alpha, col = np.zeros_like(share), np.zeros_like(sub)
             for part, size in ((share - hi, LEVELS_PX[lv]), (hi, LEVELS_PX[lv + 1])):
                 if not part.any():
                     continue
                 if size < 0.5:
                     alpha += part
-                    col += img * part[..., None]
+                    col += sub * part[..., None]
                 else:
                     k = disc(size)
                     alpha += cv2.filter2D(part, -1, k, borderType=cv2.BORDER_REFLECT)
-                    col += cv2.filter2D(img * part[..., None], -1, k, borderType=cv2.BORDER_REFLECT)
+                    col += cv2.filter2D(sub * part[..., None], -1, k, borderType=cv2.BORDER_REFLECT)
             np.clip(alpha, 0.0, 1.0, out=alpha)
             if cover.any():
-                out, cover = _filled(out, cover, LEVELS_PX[min(lv + 1, len(LEVELS_PX) - 1)])
-            out = col + (1.0 - alpha)[..., None] * out
-            cover = alpha + (1.0 - alpha) * cover
+                _fill(out, cover, crop, LEVELS_PX[lv + 1])
+            out[crop] = col + (1.0 - alpha)[..., None] * out[crop]
+            cover[crop] = alpha + (1.0 - alpha) * cover[crop]
     return out / np.maximum(cover, 1e-6)[..., None]
 
 
-def _filled(out: np.ndarray, cover: np.ndarray, size_px: float) -> Tuple[np.ndarray, np.ndarray]:
-    """What lies behind the layers so far, holes included: where they do not cover a
-    pixel (a nearer object stood there), the surroundings' colour (normalised blur)."""
-    if cover.min() > 0.999:
-        return out, cover
+def _crop(layer: np.ndarray, size_px: float) -> Optional[Tuple[slice, slice]]:
+    """The layer's bounding box, grown by its blur (None for an empty layer)."""
+    rows, cols = np.flatnonzero(layer.any(axis=1)), np.flatnonzero(layer.any(axis=0))
+    if rows.size == 0:
+        return None
+    pad = math.ceil(size_px / 2) + 1
+    h, w = layer.shape
+    return (slice(max(rows[0] - pad, 0), min(rows[-1] + pad + 1, h)),
+            slice(max(cols[0] - pad, 0), min(cols[-1] + pad + 1, w)))
+
+
+def _fill(out: np.ndarray, cover: np.ndarray, crop: Tuple[slice, slice], size_px: float) -> None:
+    """Complete what lies behind the layers so far inside ``crop``, in place: where they
+    do not cover a pixel (a nearer object stood there), the surroundings' colour
+    (a normalised blur)."""
+    if cover[crop].min() > 0.999:
+        return
     sigma = max(size_px, 2.0)
-    num = cv2.GaussianBlur(out, (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
-    den = cv2.GaussianBlur(cover, (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
+    pad = int(3 * sigma) + 1
+    h, w = cover.shape
+    r0, r1 = max(crop[0].start - pad, 0), min(crop[0].stop + pad, h)
+    c0, c1 = max(crop[1].start - pad, 0), min(crop[1].stop + pad, w)
+    num = cv2.GaussianBlur(out[r0:r1, c0:c1], (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
+    den = cv2.GaussianBlur(cover[r0:r1, c0:c1], (0, 0), sigma, borderType=cv2.BORDER_REFLECT)
+    inner = (slice(crop[0].start - r0, crop[0].stop - r0), slice(crop[1].start - c0, crop[1].stop - c0))
+    num, den = num[inner], den[inner]
     known = den > 1e-4
     fill = np.where(known[..., None], num / np.maximum(den, 1e-4)[..., None], 0.0)
-    gap = (1.0 - cover) * known
-    return out + gap[..., None] * fill, cover + gap
+    gap = (1.0 - cover[crop]) * known
+    out[crop] += gap[..., None] * fill
+    cover[crop] += gap
 
 
 def soft_corners(img: np.ndarray, extra_sigma_px: float) -> np.ndarray:

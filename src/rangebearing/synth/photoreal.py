@@ -19,15 +19,15 @@ in ways no single preset asks about; these presets put all of them together
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable, Dict, Iterator
+from typing import Callable, Dict, Iterator, Tuple
 
 import numpy as np
 
 from ..core.types import CameraIntrinsics
-from . import isp
+from . import isp, surfaces
 from . import sampling as d
 from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
-from .scene import Imaging, Scene
+from .scene import RGB, Imaging, Lighting, Poster, Scene
 from .touching import touching_scene
 
 PHOTOREAL_PRESETS = ("photoreal", "photoreal-crowd")
@@ -36,6 +36,8 @@ PHOTOREAL_HELP = {
                  "(defocus, colour matrix, AWB pull, sharpening, 4:2:0/JPEG)",
     "photoreal-crowd": "crowd scenes (5-8 robots) through the same lens and ISP",
 }
+WOODS: Tuple[RGB, ...] = ((0.55, 0.38, 0.22), (0.68, 0.52, 0.34), (0.35, 0.22, 0.12), (0.75, 0.62, 0.45))
+SKIRTING: Tuple[RGB, ...] = ((0.85, 0.85, 0.83), (0.30, 0.20, 0.12), (0.08, 0.08, 0.08), (0.6, 0.6, 0.6))
 _KINDS: Dict[str, Callable[[np.random.Generator, CameraIntrinsics], Scene]] = {
     "far": far_scene, "lighting": lighting_scene, "occlusion": occlusion_scene,
     "touching": touching_scene}
@@ -66,7 +68,34 @@ def photoreal_scene(rng: np.random.Generator, preset: str, camera: CameraIntrins
     else:
         kinds = list(_KINDS)
         scene = _KINDS[kinds[int(rng.integers(len(kinds)))]](rng, camera)
-    return dataclasses.replace(scene, imaging=camera_isp(rng, scene))
+    return dataclasses.replace(scene, imaging=camera_isp(rng, scene), floor_shading=True,
+                               local_bounce=True, lighting=paint(rng, scene.lighting), **room(rng, scene))
+
+
+def room(rng: np.random.Generator, scene: Scene) -> dict:
+    """A floor of planks, tiles or carpet (or plain), and a skirting board along the wall."""
+    out: dict = {}
+    kind = ("wood", "wood", "tiles", "carpet", "")[int(rng.integers(5))]
+    if kind:
+        out.update(floor_pattern=kind, floor_pattern_params=surfaces.params(rng, kind))
+        if kind == "wood" and rng.random() < 0.6:
+            out["floor_colour"] = d.jitter(rng, WOODS[int(rng.integers(len(WOODS)))], 0.03)
+    if scene.wall_distance_m is not None and rng.random() < 0.6:
+        top = d.uniform(rng, 0.04, 0.12)
+        colour = SKIRTING[int(rng.integers(len(SKIRTING)))]
+        out["posters"] = (Poster(-50.0, 50.0, 0.0, top, d.jitter(rng, colour, 0.02)), *scene.posters)
+    return out
+
+
+def paint(rng: np.random.Generator, light: Lighting) -> Lighting:
+    """The landmark's paint (glossy plastic or matte paper) and the light's size."""
+    size = d.uniform(rng, 2.0, 15.0)
+    if rng.random() < 0.6:  # glossy plastic: highlights and the room mirrored at the silhouette
+        return dataclasses.replace(light, light_radius_deg=size, fresnel=d.uniform(rng, 0.6, 1.0),
+                                   gloss=max(light.gloss, d.uniform(rng, 0.05, 0.25)))
+    return dataclasses.replace(light, light_radius_deg=size, fresnel=0.0,
+                               gloss=min(light.gloss, d.uniform(rng, 0.0, 0.02)),
+                               shininess=d.uniform(rng, 5.0, 15.0))
 
 
 def photoreal_sequence(rng: np.random.Generator, preset: str, frames: int,

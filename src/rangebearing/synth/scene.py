@@ -169,6 +169,10 @@ class Lighting:
     landmark's semi-gloss paint, a Blinn-Phong highlight ``gloss · (n·h)^shininess``
     of every light's colour (a spotlight's can clip the band to white).
     ``exposure`` is ignored when the camera runs auto exposure.
+    ``light_radius_deg``: the directional light's angular size (a softbox, a
+    lamp's diffuser), which softens the shadows :mod:`.ground` casts on the floor.
+    ``fresnel`` > 0: the landmark's paint is glossy plastic that mirrors the
+    room at grazing angles (Schlick, F₀ = 0.04, times ``fresnel``).
     """
 
     direction: Tuple[float, float, float] = (-0.35, 0.75, -0.55)
@@ -180,12 +184,14 @@ class Lighting:
     spots: Tuple[Spot, ...] = ()
     gloss: float = 0.0
     shininess: float = 60.0
+    light_radius_deg: float = 0.0
+    fresnel: float = 0.0
 
     @property
     def plain(self) -> bool:
         """White light, no spots, no highlights: the original shading."""
         return (self.colour == (1.0, 1.0, 1.0) and self.ambient_colour == (1.0, 1.0, 1.0)
-                and not self.spots and self.gloss == 0.0)
+                and not self.spots and self.gloss == 0.0 and self.fresnel == 0.0)
 
 
 @frozen
@@ -195,6 +201,12 @@ class Scene:
     ``floor_texture`` and ``wall_texture`` > 0 vary the floor's (and mats') and
     the wall's albedo by about that fraction (a smooth pattern from 0.4 m down
     to 4 mm, as carpet, concrete or painted plaster; ``texture_seed`` picks it).
+    ``floor_pattern`` (one of :data:`.surfaces.PATTERNS`, with its
+    ``floor_pattern_params`` from :func:`.surfaces.params`) lays planks, tiles
+    or carpet pile over the floor (not its mats). ``floor_shading`` (under any
+    light but the plain one): the floor gets soft shadows and ambient occlusion from what stands on it (:mod:`.ground`);
+    ``local_bounce``: landmarks get light bounced off their robot's board and
+    the objects right beside them (:mod:`.bounce`).
 
     Examples
     --------
@@ -217,6 +229,10 @@ class Scene:
     floor_texture: float = 0.0
     wall_texture: float = 0.0
     texture_seed: int = 0
+    floor_pattern: str = ""
+    floor_pattern_params: Tuple[float, ...] = ()
+    floor_shading: bool = False
+    local_bounce: bool = False
     lighting: Lighting = Lighting()
     imaging: Imaging = Imaging()
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import texture
+from . import ground, surfaces, texture
 from .lights import Shader
 from .parts import build, primitives
 from .scene import Scene
@@ -103,6 +103,18 @@ def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader
             rad.reshape(-1, 3)[flat] = shaded
     if scene.floor_texture > 0 or scene.wall_texture > 0:
         _texture(rad, ident, dx, dy, t, scene)
+    if scene.floor_pattern:
+        floor = ident == ID_FLOOR
+        if floor.any():
+            tf = t[floor]
+            cam = scene.camera
+            rad[floor] *= surfaces.floor_gain(dx[floor] * tf, tf, tf / cam.fx_px, tf * tf / (h * cam.fy_px),
+                                              scene.floor_pattern, scene.floor_pattern_params,
+                                              scene.texture_seed + 2)
+    if shade.ground is not None and shade.ground.objects:
+        floor = (ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER))
+        if floor.any():
+            rad[floor] *= ground.factor(shade.ground, _points(dx, dy, h, t)[floor])
     return Hits(t, ident, rad)
 
 
