@@ -224,3 +224,20 @@ def test_seams_and_grout_are_anti_aliased_and_patterns_vary():
     for kind in surfaces.PATTERNS:
         g = surfaces.floor_gain(x, z, foot, foot, kind, surfaces.params(rng, kind), 3)
         assert g.shape == (4000, 3) and 0.05 < g[:, 1].std() < 0.5 and g.min() > 0.0
+
+
+def test_a_moving_landmark_blurs_about_its_mid_exposure_pose():
+    from rangebearing.synth.render import motion_steps
+    lm = LandmarkPose(0.4, 0.0, velocity_mps=(0.3, 0.0))  # crossing to the right at 0.3 m/s
+    still = Scene(camera=SMALL, landmarks=(dataclasses.replace(lm, velocity_mps=(0.0, 0.0)),), lighting=FLAT,
+                  imaging=Imaging(exposure_s=0.03))
+    moving = dataclasses.replace(still, landmarks=(lm,))
+    assert motion_steps(still) == 1 and motion_steps(moving) % 2 == 1 and motion_steps(moving) >= 5
+    row = int(SMALL.cy_px - SMALL.fy_px * 0.027 / 0.4)  # the red band
+    a = render(still)[row].astype(float)
+    b = render(moving)[row].astype(float)
+    red = lambda im: np.clip(im[:, 2] - im[:, 1], 0, None)  # noqa: E731  (BGR)
+    cols = np.arange(len(a))
+    ca, cb = (cols * red(a)).sum() / red(a).sum(), (cols * red(b)).sum() / red(b).sum()
+    assert cb == pytest.approx(ca, abs=0.3)  # blurred about the middle of the exposure
+    assert (red(b) > 4).sum() >= (red(a) > 4).sum() + 4  # 7 px of motion

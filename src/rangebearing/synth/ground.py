@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import List, Sequence, Tuple
+from typing import Dict, List, Sequence, Tuple
 
 import numpy as np
 
@@ -73,9 +73,16 @@ def standing(prims: Sequence[Primitive], groups: Sequence[Sequence[int]], light:
             continue
         x0, x1, z0, z1 = ext[:, 0].min(), ext[:, 1].max(), ext[:, 4].min(), ext[:, 5].max()
         top = float(ext[:, 3].max())
-        out.append(Standing((x0 + x1) / 2, (z0 + z1) / 2, 0.25 * ((x1 - x0) + (z1 - z0)), top,
-                            *_bake(big, (x0, x1, z0, z1), top, dirs, light, radius_deg)))
+        key = (tuple((type(p).__name__, p.extent()) for p in big), tuple(light), radius_deg)
+        baked = _BAKED.pop(key, None) or _bake(big, (x0, x1, z0, z1), top, dirs, light, radius_deg)
+        _BAKED[key] = baked  # the most recent last: a still robot of a sequence is baked once
+        while len(_BAKED) > 64:
+            del _BAKED[next(iter(_BAKED))]
+        out.append(Standing((x0 + x1) / 2, (z0 + z1) / 2, 0.25 * ((x1 - x0) + (z1 - z0)), top, *baked))
     return tuple(out)
+
+
+_BAKED: Dict[tuple, Tuple[Tuple[float, float], np.ndarray]] = {}
 
 
 def _bake(prims: Tuple[Primitive, ...], box: Tuple[float, float, float, float], top: float,

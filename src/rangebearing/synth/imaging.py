@@ -31,6 +31,8 @@ class Imaging:
     ``chroma_denoise_px`` smooths colour (not luma) by that sigma; ``sharpen``
     is the ISP's luma sharpening strength; ``chroma_420`` keeps colour at half
     resolution; ``jpeg_quality`` > 0 passes the frame through JPEG.
+    ``exposure_s`` > 0: moving landmarks (``LandmarkPose.velocity_mps``) blur
+    over that exposure time (see :func:`.render.render`).
     """
 
     blur_sigma_px: float = 0.0
@@ -56,6 +58,7 @@ class Imaging:
     sharpen: float = 0.0
     chroma_420: bool = False
     jpeg_quality: int = 0
+    exposure_s: float = 0.0
 
     @property
     def isp(self) -> bool:

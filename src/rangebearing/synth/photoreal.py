@@ -14,6 +14,9 @@ in ways no single preset asks about; these presets put all of them together
 ``photoreal``        one scene of ``far``, ``lighting``, ``occlusion`` or
                      ``touching`` kind per frame (1–4 robots, 0.15–2 m).
 ``photoreal-crowd``  ``crowd`` scenes (5–8 robots).
+``photoreal-moving`` one ``crowd-moving`` run (same camera, room and paint
+                     throughout) whose robots blur over an exposure of
+                     8–33 ms (each robot's velocity from its next frame).
 """
 
 from __future__ import annotations
@@ -27,14 +30,18 @@ from ..core.types import CameraIntrinsics
 from . import isp, surfaces
 from . import sampling as d
 from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
-from .scene import RGB, Imaging, Lighting, Poster, Scene
+from .motion import FPS as MOVING_FPS
+from .motion import crowd_sequence
+from .scene import RGB, Imaging, LandmarkPose, Lighting, Poster, Scene
 from .touching import touching_scene
 
-PHOTOREAL_PRESETS = ("photoreal", "photoreal-crowd")
+PHOTOREAL_PRESETS = ("photoreal", "photoreal-crowd", "photoreal-moving")
 PHOTOREAL_HELP = {
     "photoreal": "far/lighting/occlusion/touching scenes through the Pi Camera v1's lens and ISP "
                  "(defocus, colour matrix, AWB pull, sharpening, 4:2:0/JPEG)",
     "photoreal-crowd": "crowd scenes (5-8 robots) through the same lens and ISP",
+    "photoreal-moving": "a crowd-moving run (30 fps, robot ids) through the same lens and ISP, "
+                        "moving robots blurred over an 8-33 ms exposure",
 }
 WOODS: Tuple[RGB, ...] = ((0.55, 0.38, 0.22), (0.68, 0.52, 0.34), (0.35, 0.22, 0.12), (0.75, 0.62, 0.45))
 SKIRTING: Tuple[RGB, ...] = ((0.85, 0.85, 0.83), (0.30, 0.20, 0.12), (0.08, 0.08, 0.08), (0.6, 0.6, 0.6))
@@ -57,12 +64,14 @@ def camera_isp(rng: np.random.Generator, scene: Scene) -> Imaging:
         soft_corners_px=d.uniform(rng, 0.2, 1.0), lateral_colour=d.uniform(rng, -1.0, 1.0) * 0.0015,
         ccm=tuple(float(v) for row in ccm for v in row), awb_pull=d.uniform(rng, 0.15, 0.5),
         demosaic="ea" if rng.random() < 0.6 else "bilinear",
-        chroma_denoise_px=d.uniform(rng, 1.0, 2.5), sharpen=d.uniform(rng, 0.3, 1.5),
+        chroma_denoise_px=d.uniform(rng, 0.5, 1.5), sharpen=d.uniform(rng, 0.3, 1.5),
         chroma_420=fmt < 0.4, jpeg_quality=int(rng.integers(75, 96)) if fmt >= 0.7 else 0)
 
 
 def photoreal_scene(rng: np.random.Generator, preset: str, camera: CameraIntrinsics) -> Scene:
     """One frame of a photoreal preset (see the module docstring)."""
+    if preset == "photoreal-moving":
+        return next(_moving(rng, 1, camera))
     if preset == "photoreal-crowd":
         scene = crowd_scene(rng, camera)
     else:
@@ -100,9 +109,34 @@ def paint(rng: np.random.Generator, light: Lighting) -> Lighting:
 
 def photoreal_sequence(rng: np.random.Generator, preset: str, frames: int,
                        camera: CameraIntrinsics) -> Iterator[Scene]:
-    """``frames`` independent draws of a photoreal preset."""
+    """``frames`` independent draws of a photoreal preset (consecutive moments for
+    ``photoreal-moving``)."""
+    if preset == "photoreal-moving":
+        yield from _moving(rng, frames, camera)
+        return
     for _ in range(frames):
         yield photoreal_scene(rng, preset, camera)
+
+
+def _moving(rng: np.random.Generator, frames: int, camera: CameraIntrinsics) -> Iterator[Scene]:
+    look: dict = {}
+    scenes = crowd_sequence(rng, frames + 1, camera)
+    now = next(scenes, None)
+    for after in scenes:
+        assert now is not None
+        if not look:
+            imaging = dataclasses.replace(camera_isp(rng, now), exposure_s=d.uniform(rng, 0.008, 0.033))
+            look = dict(imaging=imaging, floor_shading=True, local_bounce=True,
+                        lighting=paint(rng, now.lighting), **room(rng, now))
+        yield dataclasses.replace(now, landmarks=tuple(_velocity(a, b) for a, b in
+                                                       zip(now.landmarks, after.landmarks)), **look)
+        now = after
+
+
+def _velocity(now: LandmarkPose, after: LandmarkPose) -> LandmarkPose:
+    fps = MOVING_FPS
+    return dataclasses.replace(now, velocity_mps=((after.x_m - now.x_m) * fps, (after.z_m - now.z_m) * fps),
+                               yaw_rate_radps=(after.heading_rad - now.heading_rad) * fps)
 
 
 def defocus_px(scene: Scene, range_m: float) -> float:

@@ -18,17 +18,20 @@ auto-exposed Bayer camera of :mod:`.sensor`).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+import math
 from typing import List, Optional, Tuple
 
 import cv2
 import numpy as np
 
-from .camera import Rect, pixel_rect, ray_grid
+from .camera import Rect, cylinder_bbox_px, pixel_rect, ray_grid
 from .scene import Scene
 from .sensor import develop_sensor
 from .trace import Cyl, Primitive, Shader, build, trace, trace_background
 
+MAX_MOTION_STEPS = 7
 SMALL_LANDMARK_PX = 2500  # image extents up to this many pixels are supersampled whole
 
 
@@ -219,4 +222,57 @@ def render(scene: Scene, rng: Optional[np.random.Generator] = None, *,
         (H, W, 3) uint8 in OpenCV's BGR order.
     """
     linear, depth = render_layers(scene, supersample)
+    steps = motion_steps(scene)
+    if steps > 1:
+        linear = _blurred(scene, linear, steps, supersample)
     return develop(linear, scene, rng, depth)
+
+
+def _blurred(scene: Scene, linear: np.ndarray, steps: int, supersample: int) -> np.ndarray:
+    """The mean of ``steps`` moments of the exposure (the scene is the middle one), each
+    re-rendered only where a moving robot is during the exposure."""
+    e, cam = scene.imaging.exposure_s, scene.camera
+    rect = None
+    for lm in scene.landmarks:
+        if lm.velocity_mps == (0.0, 0.0) and lm.yaw_rate_radps == 0.0:
+            continue
+        foot = 1.6 * (lm.body.footprint_m if lm.body else scene.robot_radius_m)
+        for end in (lm.moved(-e / 2), lm.moved(e / 2)):
+            box = cylinder_bbox_px(scene, end.x_m, end.z_m, foot, 0.0, end.base_height_m + scene.geometry.height_m)
+            if box is None:
+                continue
+            r = (int(box[1]) - 3, int(box[3]) + 5, int(box[0]) - 3, int(box[2]) + 5)
+            rect = r if rect is None else (min(rect[0], r[0]), max(rect[1], r[1]),
+                                           min(rect[2], r[2]), max(rect[3], r[3]))
+    if rect is None:
+        return linear
+    r0, r1 = max(rect[0], 0), min(rect[1], cam.height_px)
+    c0, c1 = max(rect[2], 0), min(rect[3], cam.width_px)
+    if r1 <= r0 or c1 <= c0:
+        return linear
+    crop = dataclasses.replace(cam, cx_px=cam.cx_px - c0, cy_px=cam.cy_px - r0, width_px=c1 - c0,
+                               height_px=r1 - r0)
+    total = linear[r0:r1, c0:c1].copy()
+    for k in range(steps):
+        dt = e * ((k + 0.5) / steps - 0.5)
+        if abs(dt) > 1e-12:
+            moved = dataclasses.replace(scene, camera=crop, landmarks=tuple(lm.moved(dt) for lm in scene.landmarks))
+            total += render_layers(moved, min(supersample, 2))[0]  # the moments smooth edges too
+    out = linear.copy()
+    out[r0:r1, c0:c1] = total / steps
+    return out
+
+
+def motion_steps(scene: Scene) -> int:
+    """Moments of the exposure to average: one per ~2 px the fastest landmark moves
+    in the image during ``exposure_s``, odd (1: no blur), at most :data:`MAX_MOTION_STEPS`."""
+    e = scene.imaging.exposure_s
+    if e <= 0:
+        return 1
+    fx = scene.camera.fx_px
+    px = 0.0
+    for lm in scene.landmarks:
+        speed = math.hypot(*lm.velocity_mps) + abs(lm.yaw_rate_radps) * 0.05
+        px = max(px, fx * speed * e / max(lm.z_m, 0.05))
+    n = min(max(math.ceil(px / 2.0), 1), MAX_MOTION_STEPS)
+    return int(n if n % 2 else n + 1)  # odd: the middle moment is the scene itself

@@ -8,6 +8,7 @@ right, Y up, Z forward along the (horizontal) optical axis. A landmark at range
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Optional, Tuple
 
@@ -71,7 +72,10 @@ class LandmarkPose:
     to ``base_height_m`` (the original presets); with a :class:`RobotBody` it is
     a Zumo-like robot turned to ``heading_rad`` (0 = facing the camera's +X,
     counter-clockwise seen from above). ``robot_id`` names the robot across the
-    frames of a sequence (-1: not tracked).
+    frames of a sequence (-1: not tracked). ``velocity_mps`` (world X, Z) and
+    ``yaw_rate_radps`` are its motion at this moment: with
+    ``Imaging.exposure_s`` > 0 the frame is blurred by it (the pose is the
+    middle of the exposure).
     """
 
     range_m: float
@@ -80,6 +84,17 @@ class LandmarkPose:
     heading_rad: float = 0.0
     body: Optional[RobotBody] = None
     robot_id: int = -1
+    velocity_mps: Tuple[float, float] = (0.0, 0.0)
+    yaw_rate_radps: float = 0.0
+
+    def moved(self, dt_s: float) -> LandmarkPose:
+        """Where it is ``dt_s`` later, moving as it does now."""
+        if self.velocity_mps == (0.0, 0.0) and self.yaw_rate_radps == 0.0:
+            return self
+        x = self.x_m + self.velocity_mps[0] * dt_s
+        z = self.z_m + self.velocity_mps[1] * dt_s
+        return dataclasses.replace(self, range_m=math.hypot(x, z), bearing_rad=math.atan2(-x, z),
+                                   heading_rad=self.heading_rad + self.yaw_rate_radps * dt_s)
 
     @property
     def x_m(self) -> float:
