@@ -241,3 +241,18 @@ def test_a_moving_landmark_blurs_about_its_mid_exposure_pose():
     ca, cb = (cols * red(a)).sum() / red(a).sum(), (cols * red(b)).sum() / red(b).sum()
     assert cb == pytest.approx(ca, abs=0.3)  # blurred about the middle of the exposure
     assert (red(b) > 4).sum() >= (red(a) > 4).sum() + 4  # 7 px of motion
+
+
+def test_a_brick_wall_has_mortar_lines_that_fade_with_distance():
+    rng = np.random.default_rng(2)
+    x, y = rng.uniform(-1, 1, 5000), rng.uniform(0, 0.5, 5000)
+    red = (0.42, 0.14, 0.09)
+    near = surfaces.brick_gain(x, y, np.full(x.shape, 1e-4), red, 1)
+    mortar = np.asarray(surfaces.MORTAR) / np.asarray(red)
+    in_joint = np.isclose(near, mortar[None], rtol=1e-6).all(axis=1)
+    assert 0.15 < in_joint.mean() < 0.25  # 10 mm joints on 75 x 225 mm courses: ~17 %
+    far = surfaces.brick_gain(x, y, np.full(x.shape, 0.2), red, 1)  # footprint wider than a brick
+    assert not np.isclose(far, mortar[None], rtol=1e-6).all(axis=1).any()
+    wall = Scene(camera=SMALL, wall_colour=red, brick_wall=True, lighting=Lighting(gloss=0.01))
+    img = render_layers(wall)[0][:80]
+    assert img[..., 1].std() > 0.01 and img[..., 2].mean() > 0

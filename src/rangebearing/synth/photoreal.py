@@ -44,6 +44,7 @@ PHOTOREAL_HELP = {
                         "moving robots blurred over an 8-33 ms exposure",
 }
 WOODS: Tuple[RGB, ...] = ((0.55, 0.38, 0.22), (0.68, 0.52, 0.34), (0.35, 0.22, 0.12), (0.75, 0.62, 0.45))
+BRICKS: Tuple[RGB, ...] = ((0.42, 0.14, 0.09), (0.50, 0.25, 0.15), (0.62, 0.55, 0.45))
 SKIRTING: Tuple[RGB, ...] = ((0.85, 0.85, 0.83), (0.30, 0.20, 0.12), (0.08, 0.08, 0.08), (0.6, 0.6, 0.6))
 _KINDS: Dict[str, Callable[[np.random.Generator, CameraIntrinsics], Scene]] = {
     "far": far_scene, "lighting": lighting_scene, "occlusion": occlusion_scene,
@@ -82,13 +83,19 @@ def photoreal_scene(rng: np.random.Generator, preset: str, camera: CameraIntrins
 
 
 def room(rng: np.random.Generator, scene: Scene) -> dict:
-    """A floor of planks, tiles or carpet (or plain), and a skirting board along the wall."""
+    """A floor of planks, tiles or carpet (or plain), bricks (most red walls, now and then
+    another), and a skirting board along the wall."""
     out: dict = {}
     kind = ("wood", "wood", "tiles", "carpet", "")[int(rng.integers(5))]
     if kind:
         out.update(floor_pattern=kind, floor_pattern_params=surfaces.params(rng, kind))
         if kind == "wood" and rng.random() < 0.6:
             out["floor_colour"] = d.jitter(rng, WOODS[int(rng.integers(len(WOODS)))], 0.03)
+    reddish = scene.wall_colour[0] > 1.5 * scene.wall_colour[2]
+    if scene.wall_distance_m is not None and rng.random() < (0.7 if reddish else 0.12):
+        out["brick_wall"] = True
+        if not reddish:
+            out["wall_colour"] = d.jitter(rng, BRICKS[int(rng.integers(len(BRICKS)))], 0.02)
     if scene.wall_distance_m is not None and rng.random() < 0.6:
         top = d.uniform(rng, 0.04, 0.12)
         colour = SKIRTING[int(rng.integers(len(SKIRTING)))]

@@ -218,7 +218,8 @@ class Scene:
     to 4 mm, as carpet, concrete or painted plaster; ``texture_seed`` picks it).
     ``floor_pattern`` (one of :data:`.surfaces.PATTERNS`, with its
     ``floor_pattern_params`` from :func:`.surfaces.params`) lays planks, tiles
-    or carpet pile over the floor (not its mats). ``floor_shading`` (under any
+    or carpet pile over the floor (not its mats); ``brick_wall`` lays the wall
+    in bricks (:func:`.surfaces.brick_gain`). ``floor_shading`` (under any
     light but the plain one): the floor gets soft shadows and ambient occlusion from what stands on it (:mod:`.ground`);
     ``local_bounce``: landmarks get light bounced off their robot's board and
     the objects right beside them (:mod:`.bounce`).
@@ -246,6 +247,7 @@ class Scene:
     texture_seed: int = 0
     floor_pattern: str = ""
     floor_pattern_params: Tuple[float, ...] = ()
+    brick_wall: bool = False
     floor_shading: bool = False
     local_bounce: bool = False
     lighting: Lighting = Lighting()

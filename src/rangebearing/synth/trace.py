@@ -111,6 +111,12 @@ def trace_background(dx: np.ndarray, dy: np.ndarray, scene: Scene, shade: Shader
             rad[floor] *= surfaces.floor_gain(dx[floor] * tf, tf, tf / cam.fx_px, tf * tf / (h * cam.fy_px),
                                               scene.floor_pattern, scene.floor_pattern_params,
                                               scene.texture_seed + 2)
+    if scene.brick_wall and zw is not None:
+        wall = ident == ID_WALL
+        if wall.any():
+            rad[wall] *= surfaces.brick_gain(dx[wall] * zw, h + dy[wall] * zw,
+                                             np.full(int(wall.sum()), zw / scene.camera.fx_px),
+                                             scene.wall_colour, scene.texture_seed + 3)
     if shade.ground is not None and shade.ground.objects:
         floor = (ident == ID_FLOOR) | ((ident >= ID_PATCH) & (ident < ID_POSTER))
         if floor.any():
