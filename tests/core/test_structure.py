@@ -140,3 +140,35 @@ def test_a_band_merged_with_a_red_floor_below_is_still_paired():
     img[29:62, 71:75] = RED
     (c,) = search(img)
     assert c.red_bbox_px[:3] == (50, 20, 21) and c.white_px == 24
+
+
+def test_a_nearer_landmark_beside_a_farther_one_is_cut_where_the_white_height_steps():
+    # the far one peeks out on the left; its edges are 2 rows inside the near one's: no jump
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    img[24:31, 38:50] = RED  # far: 7-row band, 20-row white body (silhouette 17.5 columns), 12 seen
+    img[31:51, 38:50] = WHITE
+    img[51:58, 38:50] = BLUE
+    landmark(img, 50, 20, 9, 21)  # near: 24-row white body, 21 columns
+    found = sorted(search(img), key=lambda c: c.red_bbox_px[0])
+    assert [c.white_px for c in found] == [20, 24]
+    far, near = found
+    assert near.red_bbox_px[0] == 50 and near.red_bbox_px[2] == 21 and near.visible == pytest.approx(1.0)
+    assert far.red_bbox_px[0] == 38 and far.cut_right and not far.cut_left and far.visible < 0.9
+
+
+def test_a_landmark_behind_its_own_camera_and_mast_is_one_whole_candidate():
+    img = np.full((140, 160, 3), GREY, np.uint8)
+    landmark(img, 50, 20, 12, 28)  # 32-row white body from row 32, blue band rows 64-76
+    img[40:58, 58:72] = (40, 70, 40)  # a dark green camera box in front of the white body
+    img[58:100, 63:67] = (30, 30, 30)  # its mast, through the blue band: the blue region falls in two
+    (c,) = search(img)
+    assert c.red_bbox_px[0] == 50 and c.red_bbox_px[2] == 28 and c.white_px == 32
+    assert c.visible == pytest.approx(1.0)
+
+
+def test_a_dark_chassis_between_a_red_box_and_a_blue_mat_is_no_white_body():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    img[20:30, 50:71] = RED  # a red box's lower edge ...
+    img[30:54, 50:71] = (50, 50, 50)  # ... a dark robot chassis (grey enough for the white class) ...
+    img[54:64, 50:71] = BLUE  # ... and a blue mat: the shape of a landmark, but no white body
+    assert search(img) == []

@@ -7,7 +7,7 @@ Columns are independent, so every pair window of a frame is scanned in one stack
 
 from __future__ import annotations
 
-from typing import List, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -143,10 +143,12 @@ def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] =
 
 Window = Tuple[int, int, int, int]  # y0, y1, x0, x1 of a pair's window in the masks
 RunStats = Tuple[int, int, float, float, float, float, float]  # s0, s1 and the run's medians (see window_runs)
+Split = Callable[[List[Tuple[int, int]], np.ndarray, np.ndarray, np.ndarray, np.ndarray], List[Tuple[int, int]]]
 STACK_WASTE = 4  # a window joins a stack of taller ones while it is at least 1/STACK_WASTE of their height
 
 
-def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) -> List[List[RunStats]]:
+def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
+                split: Optional[Split] = None) -> List[List[RunStats]]:
     """The runs of every pair window, searched together.
 
     The windows are put side by side, top-aligned, into a few stacked arrays
@@ -159,6 +161,9 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) 
     columns ``[s0, s1)`` in the window and the medians over them of the white gap
     ``y2 − y1 − 1``, the red and blue run lengths and the (bridged, smoothed)
     edges, window rows.
+
+    ``split(runs, e1, e2, run_r, run_b)`` may cut the runs further on their
+    per-column edges and band runs (:func:`.fragments.split_runs`).
     """
     out: List[List[RunStats]] = [[] for _ in wins]
     heights = [w[1] - w[0] for w in wins]
@@ -183,6 +188,8 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window]) 
         starts = offs[1:-1]
         ok, e1, e2 = bridge(ok, e1, e2, starts)
         found = runs(ok, e1, e2, starts)
+        if split is not None:  # runs never cross a window start, so neither do their pieces
+            found = split(found, e1, e2, run_r, run_b)
         if not found:
             continue
         s0 = np.array([f[0] for f in found], np.int64)

@@ -26,6 +26,7 @@ All coordinates here are in the downscaled masks' pixels until
 from __future__ import annotations
 
 import dataclasses
+import functools
 from typing import List, Tuple
 
 import cv2
@@ -33,6 +34,7 @@ import numpy as np
 
 from .._compat import frozen
 from .columns import bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
+from .fragments import Fragment, join_fragments, lit_like_bands, split_runs
 from .types import BBox, LandmarkGeometry
 
 MAX_REGIONS = 48  # largest regions of each colour considered (bounds the cost of a frame full of specks)
@@ -141,44 +143,50 @@ def candidates(
          int(min(reds[i, 1] + reds[i, 3], blues[j, 1] + blues[j, 3])))
         for i, j in pairs
     ]
-    for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins)):
-        for s0, s1, gap, med_r, med_b, med_1, med_2 in found:
-            n = s1 - s0
-            if gap < 2:  # bridged or smoothed below the thinnest white body
+    split = functools.partial(split_runs, band_k=band_k, width_k=width_k, merged_k=MERGED)
+    frags: List[Fragment] = [
+        (float(x0 + s0), float(x0 + s1), med_1 + y0, med_2 + y0, gap, med_r, med_b)
+        for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins, split))
+        for s0, s1, gap, med_r, med_b, med_1, med_2 in found
+    ]
+    for c0f, c1f, ey1, ey2, gap, med_r, med_b in join_fragments(frags, red, blue, band_k, width_k):
+        s0, s1 = int(c0f), int(c1f)
+        n = s1 - s0
+        if gap < 2:  # bridged or smoothed below the thinnest white body
+            continue
+        hb, w_exp = band_k * gap, width_k * gap
+        ratio = n / w_exp
+        red_merged = med_r > MERGED * hb + 1
+        blue_merged = med_b > MERGED * hb + 1
+        k = round(ratio)
+        if ratio > 1 + SPLIT_TOL:
+            if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
                 continue
-            hb, w_exp = band_k * gap, width_k * gap
-            ratio = n / w_exp
-            red_merged = med_r > MERGED * hb + 1
-            blue_merged = med_b > MERGED * hb + 1
-            k = round(ratio)
-            if ratio > 1 + SPLIT_TOL:
-                if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
-                    continue
-                pieces = [(s0 + n * q / k, s0 + n * (q + 1) / k) for q in range(k)]
-            elif ratio < MIN_VISIBLE or n < 2:
+            pieces = [(s0 + n * q / k, s0 + n * (q + 1) / k) for q in range(k)]
+        elif ratio < MIN_VISIBLE or n < 2:
+            continue
+        else:
+            pieces = [(float(s0), float(s1))]
+        rrows = (round(ey1 - hb + 1), int(ey1) + 1)
+        brows = (int(ey2), round(ey2 + hb))
+        if not lit_like_bands(hsv, s0, s1, rrows, brows):
+            continue
+        reach = 1 + round(0.08 * w_exp)
+        for q, (p0, p1) in enumerate(pieces):
+            c0, c1 = round(p0), round(p1)
+            left = q > 0 or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
+            right = (q < len(pieces) - 1 or _continues(red, rrows, c1 - 1 + reach)
+                     or _continues(blue, brows, c1 - 1 + reach))
+            rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
+            bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
+            if any(_overlaps(rb, t) for t in taken):
                 continue
-            else:
-                pieces = [(float(s0), float(s1))]
-            ey1 = med_1 + y0
-            ey2 = med_2 + y0
-            rrows = (round(ey1 - hb + 1), int(ey1) + 1)
-            brows = (int(ey2), round(ey2 + hb))
-            reach = 1 + round(0.08 * w_exp)
-            for q, (p0, p1) in enumerate(pieces):
-                c0, c1 = x0 + round(p0), x0 + round(p1)
-                left = q > 0 or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
-                right = (q < len(pieces) - 1 or _continues(red, rrows, c1 - 1 + reach)
-                         or _continues(blue, brows, c1 - 1 + reach))
-                rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
-                bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
-                if any(_overlaps(rb, t) for t in taken):
-                    continue
-                taken.append(rb)
-                # the pattern fails in about one column at the limbs together (mixed pixels): count it back
-                vis = min(1.0, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
-                out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis))
-                if len(out) >= max_landmarks:
-                    return occluded_sides(out, scale)
+            taken.append(rb)
+            # the pattern fails in about one column at the limbs together (mixed pixels): count it back
+            vis = min(1.0, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
+            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis))
+            if len(out) >= max_landmarks:
+                return occluded_sides(out, scale)
     return occluded_sides(out, scale)
 
 

@@ -1,0 +1,165 @@
+"""A landmark's columns made whole: runs split where the white body's height steps, fragments joined
+across what hides the body, and structures whose "white body" is darker than their bands dropped
+(see :mod:`.structure`).
+
+Two things make a run of continuous edges not one landmark:
+
+* **A nearer landmark beside or in front of a farther one** at nearly the same image height. After
+  blur their edges differ by a pixel or two and change over a few columns, so no single column
+  jumps. Their white bodies' heights (their ranges) differ: the run is split where the edges
+  step, when it is too wide for the taller body and the taller piece is a whole silhouette (the
+  landmark in front is seen whole).
+* **Something thin in front of the white body** (a robot's own camera on its mast, a neighbour's
+  mast): the columns behind it are not red→white→blue and the landmark falls apart into
+  fragments too narrow to report, often in different region pairs (the mast cuts the blue band's
+  region in two). Its bands run on behind the obstacle at the same rows: fragments whose edges
+  agree are joined when the bands continue across the gap and the whole is at most one
+  silhouette wide; fragments that overlap or touch with agreeing edges are one structure found
+  in two windows and are joined whatever their width.
+
+Coordinates are the downscaled masks' pixels.
+"""
+
+from __future__ import annotations
+
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+STEP_PX = 1.5  # an edge or white height that differs by this much between two pieces is another landmark
+MIN_PIECE = 2  # columns of the narrowest piece a run is split into
+MIN_SHARE = 0.15  # share of a silhouette each fragment joined across a gap must show
+WHOLE_TOL = 0.3  # the taller piece of a split must be within this share of one silhouette
+WIDE = 1.1  # a run wider than this many silhouettes of its taller part is examined for a step
+JOIN_TOL = 0.3  # fragments joined across a gap make at most 1 + JOIN_TOL silhouettes
+BRIDGE = 2  # columns between two pieces that need no look at the bands (as the column scan bridges)
+BAND_SHARE = 0.75  # share of the gap's columns where a band must continue (the obstacle may cross the other)
+
+BODY_V_SHARE = 0.7  # the white body's median V over the bands' (white paint is brighter than either, lit alike)
+
+# (c0, c1, y1, y2, gap, run_r, run_b): columns [c0, c1), median inner edges y1 (red bottom) and
+# y2 (blue top), white height gap = y2 − y1 − 1, median band runs
+Fragment = Tuple[float, float, float, float, float, float, float]
+
+
+def height_steps(e1: np.ndarray, e2: np.ndarray, width_k: float, depth: int = 2) -> List[Tuple[int, int]]:
+    """``[start, stop)`` pieces of one run (per-column edges ``e1``, ``e2``) with one landmark each."""
+    n = len(e1)
+    g = e2 - e1 - 1.0
+    if depth == 0 or n < 2 * MIN_PIECE or n <= WIDE * width_k * float(np.max(g)):
+        return [(0, n)]
+    # the split that best explains both edges by two levels (CUSUM of the edges)
+    c = np.arange(MIN_PIECE, n - MIN_PIECE + 1)
+    score = np.zeros(len(c))
+    for e in (e1, e2):
+        cs = np.concatenate(([0.0], np.cumsum(e)))
+        left, right = cs[c] / c, (cs[n] - cs[c]) / (n - c)
+        score += c * (n - c) / n * (left - right) ** 2
+    k = int(c[int(np.argmax(score))])
+    gl, gr = float(np.median(g[:k])), float(np.median(g[k:]))
+    steps = (abs(gl - gr), abs(float(np.median(e1[:k]) - np.median(e1[k:]))),
+             abs(float(np.median(e2[:k]) - np.median(e2[k:]))))
+    tall, (t0, t1) = (gl, (0, k)) if gl >= gr else (gr, (k, n))
+    if n <= WIDE * width_k * tall or max(steps) < STEP_PX:
+        return [(0, n)]
+    if abs((t1 - t0) / (width_k * tall) - 1.0) > WHOLE_TOL:  # the one in front must be seen whole
+        return [(0, n)]
+    left = height_steps(e1[:k], e2[:k], width_k, depth - 1)
+    right = height_steps(e1[k:], e2[k:], width_k, depth - 1)
+    return left + [(a + k, b + k) for a, b in right]
+
+
+def split_runs(
+    found: Sequence[Tuple[int, int]], e1: np.ndarray, e2: np.ndarray, run_r: np.ndarray, run_b: np.ndarray,
+    band_k: float, width_k: float, merged_k: float,
+) -> List[Tuple[int, int]]:
+    """The runs ``found`` (``[start, stop)`` over per-column edges and band runs) cut by :func:`height_steps`.
+
+    A run whose band runs on past ``merged_k`` band heights (plus one) is merged with a same-coloured
+    background and kept whole, as a wide run with a merged band is never split at one range either.
+    """
+    out: List[Tuple[int, int]] = []
+    for r0, r1 in found:
+        hb = band_k * float(np.median(e2[r0:r1] - e1[r0:r1] - 1))
+        if max(float(np.median(run_r[r0:r1])), float(np.median(run_b[r0:r1]))) > merged_k * hb + 1:
+            out.append((r0, r1))
+            continue
+        out.extend((r0 + a, r0 + b) for a, b in height_steps(e1[r0:r1], e2[r0:r1], width_k))
+    return out
+
+
+def _band_share(mask: np.ndarray, rows: Tuple[int, int], c0: int, c1: int) -> float:
+    """Share of columns ``[c0, c1)`` where ``mask`` is mostly set in ``rows``."""
+    r0, r1 = max(0, rows[0]), max(0, min(mask.shape[0], rows[1]))
+    if r1 <= r0 or c1 <= c0:
+        return 0.0
+    seg = mask[r0:r1, c0:c1] > 0
+    return float(np.mean(seg.mean(axis=0) > 0.5))
+
+
+def join_fragments(
+    frags: Sequence[Fragment], red: np.ndarray, blue: np.ndarray, band_k: float, width_k: float
+) -> List[Fragment]:
+    """Fragments of one landmark joined (see the module notes), in the order of their first member."""
+    if len(frags) < 2:
+        return list(frags)
+    f = np.asarray(frags, np.float64)
+    c0, c1, y1, y2, g = f[:, 0], f[:, 1], f[:, 2], f[:, 3], f[:, 4]
+    tol = 1.5 + 0.05 * np.maximum(g[:, None], g[None, :])
+    agree = (np.abs(y1[:, None] - y1[None, :]) <= tol) & (np.abs(y2[:, None] - y2[None, :]) <= tol)
+    np.fill_diagonal(agree, False)
+    parent = list(range(len(f)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i, j in zip(*np.nonzero(np.triu(agree))):
+        a, b = (i, j) if c0[i] <= c0[j] else (j, i)
+        lo, hi = int(c1[a]), int(c0[b])
+        shared = min(c1[a], c1[b]) - c0[b]
+        if shared < 0.5 * min(c1[a] - c0[a], c1[b] - c0[b]):  # not one structure seen in two windows
+            h = max(g[a], g[b])
+            if max(c1[a], c1[b]) - c0[a] > (1 + JOIN_TOL) * width_k * h:
+                continue
+            if hi > lo + BRIDGE:  # a gap: the bands must run on behind whatever hides the body
+                least = max(MIN_PIECE, MIN_SHARE * width_k * h)  # a column or two of edge noise counts for nothing
+                if min(c1[a] - c0[a], c1[b] - c0[b]) < least:
+                    continue
+                inside = np.minimum(c1, hi) - np.maximum(c0, lo)
+                if np.any(~agree[a] & (inside >= least) & (inside >= 0.5 * (c1 - c0))):
+                    continue  # another structure's columns fill the gap: no obstacle hides this one there
+                hb = max(1, round(0.5 * band_k * h))
+                ye1, ye2 = round(0.5 * (y1[a] + y1[b])), round(0.5 * (y2[a] + y2[b]))
+                if max(_band_share(red, (ye1 - hb + 1, ye1 + 1), lo, hi),
+                       _band_share(blue, (ye2, ye2 + hb), lo, hi)) < BAND_SHARE:
+                    continue
+        parent[root(int(i))] = root(int(j))
+    groups: dict = {}
+    for i in range(len(f)):
+        groups.setdefault(root(i), []).append(i)
+    out = []
+    for members in sorted(groups.values(), key=min):
+        if len(members) == 1:
+            out.append(tuple(frags[members[0]]))
+            continue
+        m = f[members]
+        w = m[:, 1] - m[:, 0]
+        widest = m[int(np.argmax(w))]
+        out.append((float(m[:, 0].min()), float(m[:, 1].max()), *map(float, widest[2:])))
+    return out  # type: ignore[return-value]
+
+
+def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], brows: Tuple[int, int]) -> bool:
+    """Whether the body between a structure's bands (columns ``[c0, c1)``) is as bright as a white
+    body beside them: white paint is at least as bright as the bands' brightest channel in any
+    light, so a dark robot chassis or shadow between a red box and a blue mat is no white body.
+
+    ``hsv`` is indexed once, with two slices (it may convert only that window)."""
+    top = max(0, rrows[0])
+    v = hsv[top : max(top, brows[1]), c0:c1][..., 2]
+    body = v[rrows[1] - top : brows[0] - top]
+    bands = np.concatenate((v[: rrows[1] - top].ravel(), v[brows[0] - top :].ravel()))
+    return body.size == 0 or bands.size == 0 or float(np.median(body)) >= BODY_V_SHARE * float(np.median(bands))
