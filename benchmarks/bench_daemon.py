@@ -7,7 +7,8 @@ frame rate. A listener on 127.0.0.1 stamps every datagram on arrival. From
 starts once frames flow, RSS (VmRSS) and its peak (VmHWM). Latency is the
 datagram's arrival minus its ``t`` (the frame's capture time on the wall
 clock), so it covers capture → process → send → receive. Start-up is from
-``Popen`` to the first datagram; the window opens after one whole loop of
+``Popen`` to the first datagram (with the package's bytecode compiled
+beforehand, as pip does at install, and the CPU time spent by then beside it); the window opens after one whole loop of
 the recording (the decoding of the PNGs stays out of it). The subprocess inherits the benchmark's
 one-core affinity.
 """
@@ -17,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import shutil
 import signal
 import socket
@@ -58,6 +60,10 @@ class DaemonFigures:
     rss_peak_mib: float
     exit_code: int
     error: str = ""
+    startup_cpu_s: float = float("nan")  # CPU time of the daemon (all threads) when its first datagram arrived
+    pipeline_cpu_ms: float = float("nan")  # the daemon's own figure: the pipeline's CPU per frame (its final log line)
+    tracked_pct: float = float("nan")  # frames the pipeline tracked rather than scanned whole
+    bytecode: bool = True  # the package's modules were compiled beforehand, as an installed package's are
 
 
 def _command() -> List[str]:
@@ -130,8 +136,30 @@ class Listener:
         self.sock.close()
 
 
-def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s: float) -> DaemonFigures:
-    """Run ``rangebearing run`` on ``frames`` (PNG, looped) paced at ``fps``; measure it from outside."""
+def _compile_package() -> None:
+    """Compile rangebearing's modules into their ``__pycache__`` (git ignores it), as pip does at install.
+
+    An editable checkout run with PYTHONDONTWRITEBYTECODE (as here) would
+    otherwise compile every module from source at each start, ~100 ms a robot
+    never pays; the daemon still reads bytecode that exists. (Not
+    PYTHONPYCACHEPREFIX: that moves the whole standard library's bytecode too.)
+    """
+    import rangebearing
+
+    package = Path(rangebearing.__file__).resolve().parent
+    subprocess.run([sys.executable, "-m", "compileall", "-q", str(package)], check=True, stdout=subprocess.DEVNULL)
+
+
+_SUMMARY = re.compile(r"stopped: .*pipeline CPU ([0-9.]+) ms/frame \(([0-9.]+) % tracked\)")
+
+
+def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s: float,
+               bytecode: bool = True) -> DaemonFigures:
+    """Run ``rangebearing run`` on ``frames`` (PNG, looped) paced at ``fps``; measure it from outside.
+
+    ``bytecode``: compile the package's modules beforehand (as installed); False leaves
+    them as they are (an editable checkout under PYTHONDONTWRITEBYTECODE compiles them at each start).
+    """
     with tempfile.TemporaryDirectory(prefix="rb-bench-") as tmp:
         clip = Path(tmp) / "clip"
         clip.mkdir()
@@ -148,12 +176,15 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         log = open(Path(tmp) / "daemon.log", "w+", encoding="utf-8")  # noqa: SIM115 - read back below
         env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
         env.pop("NOTIFY_SOCKET", None)
+        if bytecode:
+            _compile_package()
         t0 = time.perf_counter()
         proc = subprocess.Popen([*_command(), "run", "--config", str(conf)], stdout=log, stderr=log, env=env)
         error, code = "", -1
         try:
             if not listener.first.wait(30.0):
                 raise RuntimeError("no datagram within 30 s")
+            startup_cpu = _cpu_s(proc.pid)
             startup = listener.got[0][1] - t0
             # the first loop decodes the PNGs (a camera hands over decoded buffers): keep it out of the window
             time.sleep(len(frames) / fps + SETTLE_S)
@@ -176,7 +207,8 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
             log.close()
         if error:
             return DaemonFigures(fps, duration_s, float("nan"), 0, 0, 0, 0, *([float("nan")] * 8), code,
-                                 f"{error}; log: {tail}")
+                                 f"{error}; log: {tail}", bytecode=bytecode)
+    summary = _SUMMARY.search(tail)
     window = listener.got[n0:n1]
     lat = np.array([(arr - msg["t"]) * 1e3 for arr, _, msg in window]) if window else np.array([np.nan])
     seqs = [msg["seq"] for _, _, msg in listener.got]
@@ -199,4 +231,59 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         rss_mib=rss / 1024.0,
         rss_peak_mib=hwm / 1024.0,
         exit_code=code,
+        startup_cpu_s=startup_cpu,
+        pipeline_cpu_ms=float(summary.group(1)) if summary else float("nan"),
+        tracked_pct=float(summary.group(2)) if summary else float("nan"),
+        bytecode=bytecode,
     )
+
+
+def bench_clip(n_frames: int = 60) -> Tuple[Config, List[np.ndarray]]:
+    """The clip ``bench.py`` runs the daemon on: 640×480, one landmark, the shipped defaults (seed 7)."""
+    import bench_apriltag
+    import bench_aruco
+    from bench_frames import build_scenario
+
+    images = {"aruco": bench_aruco.marker_images, "apriltag": bench_apriltag.tag_images}
+    clip = build_scenario(Config(), 640, 480, 1, n_frames, 7, images)
+    return clip.cfg, clip.frames
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python benchmarks/bench_daemon.py [--fps 30 90] [--seconds S] [--runs N]``: the daemon rows alone."""
+    import argparse
+
+    p = argparse.ArgumentParser(prog="bench_daemon.py", description=main.__doc__)
+    p.add_argument("--fps", type=float, nargs="+", default=[30.0, 90.0])
+    p.add_argument("--seconds", type=float, default=None, help="window per run (default 10 s at 30 fps, 5 s else)")
+    p.add_argument("--runs", type=int, default=1, help="runs per frame rate")
+    p.add_argument("--frames", type=int, default=60)
+    p.add_argument("--no-bytecode", action="store_true",
+                   help="do not compile the package's modules beforehand (whatever __pycache__ holds is used)")
+    args = p.parse_args(argv)
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    if hasattr(os, "sched_setaffinity"):
+        os.sched_setaffinity(0, {max(os.sched_getaffinity(0))})
+    cfg, frames = bench_clip(args.frames)
+    print("| fps | bytecode | start-up s (CPU s) | datagrams / due | dropped | gaps | CPU % | CPU ms/frame "
+          "| pipeline ms/frame (tracked) | rest ms/frame | p50 / p99 / max ms | RSS / peak MiB | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for fps in args.fps:
+        for _ in range(args.runs):
+            seconds = args.seconds or (10.0 if fps <= 30 else 5.0)
+            d = daemon_run(cfg, frames, fps, seconds, bytecode=not args.no_bytecode)
+            if d.error:
+                print(f"| {fps:g} | failed: {d.error[:300]} |")
+                continue
+            print(f"| {fps:g} | {'yes' if d.bytecode else 'no'} | {d.startup_s:.3f} ({d.startup_cpu_s:.3f}) "
+                  f"| {d.received} / {d.frames_expected} | {d.dropped} | {d.seq_gaps} | {d.cpu_pct:.2f} "
+                  f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "
+                  f"| {d.cpu_ms_per_frame - d.pipeline_cpu_ms:.3f} "
+                  f"| {d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / {d.latency_ms_max:.2f} "
+                  f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} | {os.getloadavg()[0]:.2f} |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    sys.exit(main())

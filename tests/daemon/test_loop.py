@@ -241,3 +241,74 @@ def test_track_ids_hold_over_frames_and_are_not_reused_after_a_reload(static_cli
     first, last = ids[0], ids[-1]
     assert first == list(range(n)) and all(frame == first for frame in ids[:6])  # a still scene keeps its ids
     assert last == list(range(n, 2 * n)) and ids[-4:] == [last] * 4  # fresh ids after the reload, none reused
+
+
+def test_a_paced_recording_stays_paced_after_the_open_budget(static_clip):
+    """The open budget bounds opening; frames past it are still never served before they are due."""
+    cfg = recorded_cfg(static_clip, loop=True)
+    cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, fps=5.0, open_timeout_s=0.05))
+    ahead_s: List[float] = []
+    daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier())
+
+    def echo(payload: bytes) -> None:
+        ahead_s.append(decode_reading(payload).t - time.time())  # > 0: a frame sent before it was captured
+        if len(ahead_s) >= 4:
+            daemon.stop()
+
+    daemon.echo = echo
+    assert daemon.run() == 0
+    assert len(ahead_s) == 4 and max(ahead_s) < 0.01
+
+
+def test_recorded_frames_are_read_in_the_loop_thread_camera_frames_in_a_reader(static_clip, fake_picamera2):
+    names = {}
+    for key, cfg in (("recorded", recorded_cfg(static_clip)), ("camera", picamera_cfg())):
+        if key == "camera":
+            fake_picamera2.WORLD.producer = static_rgb
+        daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier())
+        daemon.echo = lambda p, d=daemon, k=key: (names.setdefault(k, {t.name for t in threading.enumerate()}),
+                                                   d.stop())
+        daemon.run()
+    assert "capture" not in names["recorded"]  # no hand-off for frames that cannot wedge
+    assert "capture" in names["camera"]  # a camera call might: it runs where it cannot hold the loop
+
+
+def test_frames_borrowed_from_the_camera_are_copied_for_the_recorder(fake_picamera2):
+    fake_picamera2.WORLD.producer = static_rgb
+    kept: List[np.ndarray] = []
+
+    class Keeper:
+        def add(self, image, index, payload, t_s):
+            kept.append(image)  # kept past the next read, as the recorder's thread does
+
+        def close(self):
+            pass
+
+    daemon = Daemon(picamera_cfg(), lambda cfg, sleep: open_source(cfg.source, cfg.camera, sleep=sleep,
+                                                                   in_place=True),
+                    lambda c: MemoryPublisher(), RecordingNotifier(), recorder=Keeper())
+    daemon.echo = lambda p: len(kept) >= 3 and daemon.stop()
+    assert daemon.run() == 0
+    # the camera refills a released buffer (the fake writes 0xEE): the kept frames are copies, still the scene
+    assert len(kept) >= 3 and all(np.mean(img == 0xEE) < 0.5 for img in kept)
+
+
+def test_the_summary_says_what_the_pipeline_costs_and_how_often_it_tracks(static_clip):
+    daemon = Daemon(recorded_cfg(static_clip), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    assert daemon.run() == 0
+    s = daemon.summary()
+    assert s.pipeline_cpu_ms > 0
+    assert 50 < s.tracked_pct < 100  # 12 frames of a still scene: a full scan every eighth, tracked between
+    assert "pipeline CPU" in s.line() and "% tracked" in s.line()
+
+
+def test_freeze_gc_moves_start_up_objects_out_of_the_collector(static_clip):
+    import gc
+
+    daemon = Daemon(recorded_cfg(static_clip), opener, lambda c: MemoryPublisher(), RecordingNotifier(),
+                    freeze_gc=True)
+    try:
+        assert daemon.run() == 0
+        assert gc.get_freeze_count() > 1000
+    finally:
+        gc.unfreeze()

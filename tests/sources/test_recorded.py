@@ -317,3 +317,15 @@ def test_lores_is_the_frame_in_yuv420_and_is_kept_when_looping(static_clip):
         assert plain.read().lores_yuv420 is None  # type: ignore[union-attr]
     finally:
         plain.close()
+
+
+def test_in_place_hands_out_the_cached_frames_read_only_uncopied(tmp_path: Path) -> None:
+    write_images(tmp_path, 2)
+    source = RecordedSource(tmp_path, loop=True, in_place=True)
+    source.open()
+    first, _, again = source.read(), source.read(), source.read()
+    assert first is not None and again is not None and again.name == first.name
+    assert again.image is first.image  # decoded once, as a camera hands over its buffer
+    assert not first.image.flags.writeable and not first.borrowed  # immutable, so safe to keep
+    with pytest.raises(ValueError):
+        first.image[0, 0] = 255  # a consumer cannot alter the next loop

@@ -150,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
         recorder = recorder_for(args, cfg)
         daemon = Daemon(
             cfg, source_opener, Publishers(), Notifier(), reload=reloader(args), echo=echo,
-            view=view.hub if view else None, recorder=recorder,
+            view=view.hub if view else None, recorder=recorder, freeze_gc=True,
         )
         daemon.install_signal_handlers()
         dests = ", ".join(f"{h}:{p}" for h, p in cfg.publish.unicast)

@@ -12,8 +12,10 @@
 * At start the camera may be missing or busy (a robot that boots before its
   camera): opening is retried for ``source.open_timeout_s`` (before READY=1
   systemd's watchdog is not armed), then the same clean exit.
-* Every capture runs in a reader thread, so a call wedged inside the camera
-  stack never holds the loop: past ``timeout_s`` + 1 s it counts as a failed
+* Every camera capture runs in a reader thread, so a call wedged inside the camera
+  stack never holds the loop (a source whose ``may_block`` is False, recorded
+  and synthetic frames that only wait on the stop event, is read in the loop's
+  own thread, saving the hand-off): past ``timeout_s`` + 1 s it counts as a failed
   capture, SIGTERM still ends the run promptly, and :attr:`CaptureGuard.wedged`
   tells the caller to leave with ``os._exit`` rather than wait for the thread.
 """
@@ -39,7 +41,7 @@ class CameraGone(CameraError):
 
 
 class _Reader:
-    """One source's reads, run in a thread of their own."""
+    """One source's reads, run in a thread of their own (unless the source says its reads cannot wedge)."""
 
     def __init__(self, source: FrameSource) -> None:
         self.source = source
@@ -48,8 +50,10 @@ class _Reader:
         self.result: Union[Frame, BaseException, None] = None
         self.busy = False
         self._closing = False
-        self._thread = threading.Thread(target=self._run, name="capture", daemon=True)
-        self._thread.start()
+        # recorded and synthetic frames wait only on the stop event: read them in the loop's thread (no hand-off)
+        self.threaded = bool(getattr(source, "may_block", True))
+        if self.threaded:
+            threading.Thread(target=self._run, name="capture", daemon=True).start()
 
     def _run(self) -> None:
         while True:
@@ -122,10 +126,17 @@ class CaptureGuard:
         budget = self.start_budget_s if budget_s is None else budget_s
         deadline = self._clock() + budget
         delay = 0.5
+        opening = True
+
+        def sleep(s: float) -> bool:
+            """Ends on a stop; while opening, also at the start budget's end. Sources pace their frames with it."""
+            if not opening:
+                return self._stop.wait(s)
+            return self._stop.wait(min(s, max(0.0, deadline - self._clock()))) or self._clock() >= deadline
+
         while not self._stop.is_set():
             try:
-                source = opener(lambda s: self._stop.wait(min(s, max(0.0, deadline - self._clock())))
-                                or self._clock() >= deadline)
+                source = opener(sleep)
             except SourceError as exc:
                 left = deadline - self._clock()
                 if left <= 0:
@@ -134,10 +145,28 @@ class CaptureGuard:
                 self._stop.wait(min(delay, left))
                 delay = min(delay * 2.0, 2.0)
                 continue
+            opening = False  # the budget was for opening: frames are paced with plain, stoppable sleeps
             self._reader = _Reader(source)
             self._last_frame = self._clock()
             self._opener = opener
             return True
+        return False
+
+    def swap(self, opener: Opener, budget_s: float, old: Opener, old_budget_s: float) -> bool:
+        """Close the running source and open ``opener``'s; on failure reopen ``old`` and say False.
+
+        The old source is closed first: a camera cannot be opened twice. If the
+        old one cannot be reopened either, CameraGone ends the run (and systemd
+        restarts the service).
+        """
+        log.info("camera settings changed: reopening the frame source")
+        self.close()
+        try:
+            if self.open(opener, budget_s=budget_s):
+                return True
+        except CameraGone as exc:
+            log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
+        self.open(old, budget_s=old_budget_s)
         return False
 
     def close(self) -> None:
@@ -180,6 +209,8 @@ class CaptureGuard:
         return None
 
     def _read_once(self, reader: _Reader) -> Optional[Frame]:
+        if not reader.threaded:
+            return reader.source.read()
         if not reader.busy:
             reader.start()
         if not reader.done.wait(self.timeout_s + GRACE_S) or reader.busy:

@@ -17,6 +17,7 @@ moment, camera back-off included), 1 when the camera is gone past its budget,
 from __future__ import annotations
 
 import dataclasses
+import gc
 import logging
 import signal
 import threading
@@ -29,9 +30,9 @@ from ..core.pipeline import Pipeline
 from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
 from ..net.fit import encode_fitting
 from ..net.publisher import Publisher
-from ..sources.base import Frame, FrameSource
+from ..sources.base import Frame, FrameSource, kept
 from ..view.thresholds import Thresholds
-from .capture import CameraGone, CaptureGuard
+from .capture import CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
 from .recorder import NoRecorder, Recorder
 from .stats import LoopStats, Summary
@@ -72,6 +73,12 @@ class Daemon:
         between frames.
     recorder : Recorder, optional
         Given every frame with the reading sent for it (``run --record``); closed when the loop ends.
+    freeze_gc : bool
+        After the first frame, move every object alive (modules, config, the
+        pipeline's tables) out of the cyclic garbage collector's reach
+        (``gc.freeze``): they are never garbage, and a collection that rescans
+        them is a pause in the frame it lands on. For the daemon's own process
+        (``rangebearing run``), not for a library caller's.
     """
 
     def __init__(
@@ -84,14 +91,17 @@ class Daemon:
         echo: Optional[Echo] = None,
         view: Optional[ViewHub] = None,
         recorder: Optional[Recorder] = None,
+        freeze_gc: bool = False,
     ) -> None:
         self.cfg = cfg
+        self._freeze_gc = freeze_gc
         self._open_source = open_source
         self._open_publisher = open_publisher
         self._reload_config = reload
         self.echo = echo
         self.view = view
         self.recorder = recorder or NoRecorder()
+        self._recording = recorder is not None
         self.stats = LoopStats()
         self.house = Housekeeping(notifier, self.summary, cfg.daemon.status_interval_s)
         self._stop = threading.Event()
@@ -159,7 +169,7 @@ class Daemon:
             log.info("stopped: %s", self.summary().line())
 
     def _loop(self) -> int:
-        clock, seq = time.monotonic_ns, 0
+        clock, thread_cpu, seq = time.monotonic_ns, time.thread_time_ns, 0
         while not self._stop.is_set():
             if self._reload.is_set():
                 self._do_reload()
@@ -172,9 +182,9 @@ class Daemon:
                     if not self._stop.is_set():
                         log.info("end of stream")
                     return 0
-                t0 = clock()
+                t0, c0 = clock(), thread_cpu()
                 result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
-                t1 = clock()
+                t1, c1 = clock(), thread_cpu()
                 pub = self.cfg.publish
                 t_unix = _unix_time(frame, t1)
                 payload = encode_fitting(pub.robot_id, seq, t_unix, result.landmarks, self.stats.fps,
@@ -187,12 +197,16 @@ class Daemon:
             self._publisher.send(payload)  # type: ignore[union-attr]
             t2, seq = clock(), seq + 1
             stages = {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1}
-            self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages)
+            self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages, c1 - c0, result.tracked)
             self._echo(payload)
-            self.recorder.add(frame.image, frame.index, payload, t_unix)
+            if self._recording:
+                self.recorder.add(kept(frame), frame.index, payload, t_unix)  # the recorder's thread keeps it
+            first = not self.house.ready
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
+            if first and self._freeze_gc:
+                gc.freeze()
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
-                self.view.offer(t2, frame.image, frame.name, result, self.cfg.detection, self._view_status())
+                self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, self._view_status())
         return 0
 
     def _view_status(self) -> Dict[str, Any]:
@@ -275,22 +289,10 @@ class Daemon:
             self.house.reloaded()
 
     def _swap_source(self, new: Config) -> bool:
-        """Close the running source and open the new config's; on failure reopen the old one and say False.
-
-        The old source is closed first: a camera cannot be opened twice. If the
-        old one cannot be reopened either, CameraGone ends the run (and systemd
-        restarts the service).
-        """
-        log.info("camera settings changed: reopening the frame source")
-        self.guard.close()
-        try:
-            if self.guard.open(lambda sleep: self._open_source(new, sleep), budget_s=new.source.timeout_s * 2):
-                return True
-        except CameraGone as exc:
-            log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
+        """Open the new config's source in place of the running one (:meth:`CaptureGuard.swap`)."""
         old = self.cfg
-        self.guard.open(lambda sleep: self._open_source(old, sleep), budget_s=old.source.open_timeout_s)
-        return False
+        return self.guard.swap(lambda sleep: self._open_source(new, sleep), new.source.timeout_s * 2,
+                               lambda sleep: self._open_source(old, sleep), old.source.open_timeout_s)
 
 
 def _unix_time(frame: Frame, now_mono_ns: int) -> float:

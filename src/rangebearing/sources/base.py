@@ -32,8 +32,14 @@ class Frame:
 
     ``lores_yuv420`` is the camera's second, YUV420 stream of the same view
     (Picamera2's ``lores``), where the source has one: the pipeline searches
-    for bands on it and measures on ``image``. A camera's arrays may be views
-    into its buffers, valid until the source's next ``read()`` or ``close()``.
+    for bands on it and measures on ``image``.
+
+    ``borrowed``: the arrays are views into the camera's buffers (Picamera2
+    read in place), valid only until the source's next ``read()`` or
+    ``close()``; whoever keeps them longer (a recorder or view thread) must
+    copy them (:func:`kept`). Otherwise they are the consumer's to keep; a
+    recorded clip's cached frames are read-only, so one loop cannot alter the
+    next.
     """
 
     image: np.ndarray
@@ -41,6 +47,12 @@ class Frame:
     index: int
     name: str
     lores_yuv420: Optional[Yuv420] = None
+    borrowed: bool = False
+
+
+def kept(frame: Frame) -> np.ndarray:
+    """``frame.image`` safe to keep past the next ``read()``: a copy only when it is borrowed."""
+    return frame.image.copy() if frame.borrowed else frame.image
 
 
 def with_lores(frame: Frame) -> Frame:
@@ -52,7 +64,8 @@ def with_lores(frame: Frame) -> Frame:
     h, w = frame.image.shape[:2]
     if frame.lores_yuv420 is not None or h % 2 or w % 2:
         return frame
-    return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv420_from_bgr(frame.image))
+    return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv420_from_bgr(frame.image),
+                 frame.borrowed)
 
 
 @runtime_checkable

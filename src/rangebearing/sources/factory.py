@@ -26,8 +26,9 @@ def open_source(
     camera retries; pass ``threading.Event.wait`` so that setting the event
     cuts any wait short (a sleep that returns True ends the wait). ``in_place``
     lets the camera hand over views into its buffers, valid until the next
-    ``read()``: for a caller that is done with each frame before the next (the
-    daemon).
+    ``read()`` (``Frame.borrowed``), and a looping recording its cached frames
+    uncopied (read-only): for a caller that is done with each frame before the
+    next (the daemon).
 
     Raises
     ------
@@ -39,7 +40,7 @@ def open_source(
     if cfg.kind == "recorded":
         from .recorded import RecordedSource
 
-        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep, lores=cfg.lores)
+        source = RecordedSource(cfg.path, fps=cfg.fps, loop=cfg.loop, sleep=sleep, lores=cfg.lores, in_place=in_place)
     elif cfg.kind == "opencv":
         from .opencv_capture import OpenCVSource
 

@@ -266,7 +266,8 @@ class Picamera2Source:
             self._prev_sensor_ns = sensor_ns
         index = self._next_index
         self._next_index += 1
-        return Frame(image=image, t_mono_ns=t_ns, index=index, name=str(index), lores_yuv420=search)
+        return Frame(image=image, t_mono_ns=t_ns, index=index, name=str(index), lores_yuv420=search,
+                     borrowed=self._held is not None)
 
     def close(self) -> None:
         """Flush, stop and close the camera, waiting at most ``stop_timeout_s``."""

@@ -117,13 +117,19 @@ Fetched = Union[Optional[np.ndarray], _EndOfVideo]
 
 
 class _ImageDir:
-    """Random access to a directory's images, with a bounded cache when looping."""
+    """Random access to a directory's images, with a bounded cache when looping.
 
-    def __init__(self, directory: Path, cache: bool) -> None:
+    Cached frames are read-only; ``in_place`` hands them out as they are (a
+    camera's buffers are not copied either), otherwise each is a copy the
+    caller may draw on.
+    """
+
+    def __init__(self, directory: Path, cache: bool, in_place: bool = False) -> None:
         self.paths = list_images(directory)
         self.length: Optional[int] = len(self.paths)
         self._cache: Optional[Dict[int, Optional[np.ndarray]]] = {} if cache else None
         self._cached_bytes = 0
+        self._in_place = in_place
 
     def name(self, pos: int) -> str:
         return self.paths[pos].name
@@ -136,11 +142,14 @@ class _ImageDir:
         else:
             image = _decode(self.paths[pos])
             size = 0 if image is None else image.nbytes
-            if self._cached_bytes + size <= _CACHE_BYTES:
-                self._cache[pos] = image
-                self._cached_bytes += size
-        # A copy, so a consumer drawing on its frame cannot alter the next loop.
-        return None if image is None else image.copy()
+            if self._cached_bytes + size > _CACHE_BYTES:
+                return image  # not kept: the caller's own
+            if image is not None:
+                image.setflags(write=False)
+            self._cache[pos] = image
+            self._cached_bytes += size
+        # Else a copy, so a consumer drawing on its frame cannot alter the next loop.
+        return image if image is None or self._in_place else image.copy()
 
     def close(self) -> None:
         self._cache = None
@@ -194,7 +203,11 @@ class RecordedSource:
     injectable so tests can pace without real time passing. ``lores`` adds the
     YUV420 stream a Pi camera delivers beside each frame (OpenCV's I420 of
     it; kept with the decoded frame when looping, as the ISP makes it for free).
+    ``in_place`` (a caller done with each frame before the next, the daemon):
+    a looping clip's decoded frames are handed out read-only, uncopied.
     """
+
+    may_block = False  # reads wait only on ``sleep`` (a stop ends them): no reader thread needed
 
     def __init__(
         self,
@@ -204,8 +217,10 @@ class RecordedSource:
         clock: Callable[[], int] = time.monotonic_ns,
         sleep: Callable[[float], object] = time.sleep,
         lores: bool = False,
+        in_place: bool = False,
     ) -> None:
         self._path = path
+        self._in_place = in_place
         self._loop = loop
         self._lores = lores
         self._yuv: Dict[str, Yuv420] = {}  # by frame name, when looping
@@ -225,7 +240,7 @@ class RecordedSource:
             return
         p = _check_path(self._path)
         files = McapFrames(p, _END) if not p.is_dir() and is_mcap_file(p) else None
-        self._reader = _ImageDir(p, cache=self._loop) if p.is_dir() else files or _Video(p)
+        self._reader = _ImageDir(p, self._loop, self._in_place) if p.is_dir() else files or _Video(p)
         if self._pacer is not None:
             self._pacer.start()
         self._next = 0
@@ -275,8 +290,11 @@ class RecordedSource:
         yuv = self._yuv.get(frame.name)
         if yuv is None:
             frame = with_lores(frame)
-            if self._loop and frame.lores_yuv420 is not None and len(self._yuv) * frame.image.nbytes < _CACHE_BYTES:
-                self._yuv[frame.name] = frame.lores_yuv420
+            yuv = frame.lores_yuv420
+            if self._loop and yuv is not None and len(self._yuv) * frame.image.nbytes < _CACHE_BYTES:
+                for plane in (yuv.y, yuv.u, yuv.v):
+                    plane.setflags(write=False)  # handed out again every loop
+                self._yuv[frame.name] = yuv
             return frame
         return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 

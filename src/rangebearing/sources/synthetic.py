@@ -42,6 +42,8 @@ class SyntheticSource:
     any, is drawn from ``numpy.random.default_rng(seed)``.
     """
 
+    may_block = False  # reads wait only on ``sleep`` (a stop ends them): no reader thread needed
+
     def __init__(
         self,
         cfg: SourceConfig,
