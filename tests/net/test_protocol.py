@@ -245,3 +245,36 @@ def test_unknown_extra_fields_are_ignored() -> None:
 def test_integers_are_accepted_where_numbers_are_expected() -> None:
     r = decode_reading(_mutated(lambda m: m.update(t=100, fps=30)))
     assert r.t == 100.0 and isinstance(r.t, float) and r.fps == 30.0
+
+
+_FINITE = st.floats(allow_nan=False, allow_infinity=False, width=64)
+_ANY = st.one_of(_FINITE, st.sampled_from([math.nan, math.inf, -math.inf, -0.0, 0.0, 1e-9, math.pi, -math.pi]),
+                 st.integers(-3, 3), st.none())
+
+
+@given(st.lists(st.tuples(*[_ANY] * 15, st.one_of(st.integers(-2, 10**6), st.booleans(), st.none()),
+                          st.booleans()), min_size=1, max_size=3))
+def test_the_fast_row_is_byte_for_byte_the_checked_encoding(values: Any) -> None:
+    """Whatever the numbers, the frame-rate path writes exactly what the checked path writes, or defers to it."""
+    from rangebearing.net import protocol
+
+    lms = []
+    for v in values:
+        lms.append(RemoteLandmark(range_m=v[0], bearing_rad=v[1], in_envelope=v[16], l_px=v[2], d_v_m=v[3],
+                                  d_h_m=v[4], red_xy_px=(v[5], v[6]), blue_xy_px=(v[7], v[8]), width_px=v[9],
+                                  range_sigma_m=v[10], bearing_sigma_rad=v[11], visible=v[12], track_id=v[15],
+                                  range_rate_mps=v[13], bearing_rate_radps=v[14]))
+    for lm in lms:
+        row = protocol._row(lm)
+        if row is None:
+            continue  # the checked path decides (and raises for what cannot be sent)
+        checked = protocol.landmark_fields(lm)
+        assert json.dumps(dict(zip(protocol._COLUMNS, row))) == json.dumps(checked)
+
+
+def test_numpy_numbers_take_the_fast_row_and_encode_as_floats() -> None:
+    from rangebearing.net import protocol
+
+    lm = make_landmark(range_m=np.float64(0.41234567), bearing_rad=np.float32(-0.0698132))
+    assert protocol._row(lm) is not None
+    assert json.dumps(dict(zip(protocol._COLUMNS, protocol._row(lm)))) == json.dumps(protocol.landmark_fields(lm))

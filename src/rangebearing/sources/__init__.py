@@ -3,16 +3,36 @@
 ``RecordedSource`` (image directories and video files, paced like a camera),
 ``OpenCVSource`` (USB/V4L2 cameras, files, streams) and ``Picamera2Source``
 (the Pi camera; picamera2 is imported only when it is opened). Build the one a
-config names with :func:`open_source`.
+config names with :func:`open_source`. The backends are imported on first use,
+so the daemon loads only the one it runs (start-up time).
 """
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .base import Frame, FrameSource, validate_frame
-from .factory import open_source
-from .opencv_capture import OpenCVSource
-from .picamera2_source import Picamera2Source
-from .recorded import RecordedSource, count_recorded, iter_recorded
+
+_LAZY = {
+    "open_source": ".factory", "OpenCVSource": ".opencv_capture", "Picamera2Source": ".picamera2_source",
+    "RecordedSource": ".recorded", "count_recorded": ".recorded", "iter_recorded": ".recorded",
+}
+
+if TYPE_CHECKING:
+    from .factory import open_source
+    from .opencv_capture import OpenCVSource
+    from .picamera2_source import Picamera2Source
+    from .recorded import RecordedSource, count_recorded, iter_recorded
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "Frame",

@@ -14,6 +14,7 @@ from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
 from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
 from .pacing import Pacer
+from .video_frames import END, EndOfVideo, VideoFrames, open_video
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 PathLike = Union[str, Path]
@@ -51,14 +52,6 @@ def _check_path(path: PathLike) -> Path:
     return p
 
 
-def _open_video(path: Path) -> cv2.VideoCapture:
-    cap = cv2.VideoCapture(str(path))
-    if not cap.isOpened():
-        cap.release()
-        raise SourceError(f"{path}: OpenCV cannot open this as a video")
-    return cap
-
-
 def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     """Yield ``(name, image)`` for every recorded frame, decoding one at a time.
 
@@ -80,7 +73,7 @@ def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     if is_mcap_file(p):
         yield from iter_mcap(p)
         return
-    cap = _open_video(p)
+    cap = open_video(p)
     try:
         i = 0
         while True:
@@ -100,7 +93,7 @@ def count_recorded(path: PathLike) -> Optional[int]:
         return len(list_images(p))
     if is_mcap_file(p):
         return count_mcap(p)
-    cap = _open_video(p)
+    cap = open_video(p)
     try:
         n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
     finally:
@@ -108,12 +101,7 @@ def count_recorded(path: PathLike) -> Optional[int]:
     return n if n > 0 else None
 
 
-class _EndOfVideo:
-    """Returned by a reader asked for a position past the end."""
-
-
-_END = _EndOfVideo()
-Fetched = Union[Optional[np.ndarray], _EndOfVideo]
+Fetched = Union[Optional[np.ndarray], EndOfVideo]
 
 
 class _ImageDir:
@@ -155,41 +143,6 @@ class _ImageDir:
         self._cache = None
 
 
-class _Video:
-    """Sequential access to a video; seeking backwards reopens, skipping grabs."""
-
-    def __init__(self, path: Path) -> None:
-        self._path = path
-        self._cap: Optional[cv2.VideoCapture] = _open_video(path)
-        self._pos = 0  # position of the frame the capture returns next
-        self.length: Optional[int] = None  # learned when the end is reached
-
-    def name(self, pos: int) -> str:
-        return str(pos)
-
-    def get(self, pos: int) -> Fetched:
-        if self._cap is None or pos < self._pos:
-            self.close()
-            self._cap = _open_video(self._path)
-            self._pos = 0
-        while self._pos < pos:
-            if not self._cap.grab():
-                self.length = self._pos
-                return _END
-            self._pos += 1
-        ok, image = self._cap.read()
-        if not ok:
-            self.length = pos
-            return _END
-        self._pos += 1
-        return image
-
-    def close(self) -> None:
-        if self._cap is not None:
-            self._cap.release()
-            self._cap = None
-
-
 class RecordedSource:
     """Recorded frames served like a live camera.
 
@@ -226,7 +179,7 @@ class RecordedSource:
         self._yuv: Dict[str, Yuv420] = {}  # by frame name, when looping
         self._clock = clock
         self._pacer = Pacer(float(fps), clock, sleep) if fps else None
-        self._reader: Union[_ImageDir, _Video, McapFrames, None] = None
+        self._reader: Union[_ImageDir, VideoFrames, McapFrames, None] = None
         self._next = 0
         self._dropped = 0
 
@@ -239,8 +192,8 @@ class RecordedSource:
         if self._reader is not None:
             return
         p = _check_path(self._path)
-        files = McapFrames(p, _END) if not p.is_dir() and is_mcap_file(p) else None
-        self._reader = _ImageDir(p, self._loop, self._in_place) if p.is_dir() else files or _Video(p)
+        files = McapFrames(p, END) if not p.is_dir() and is_mcap_file(p) else None
+        self._reader = _ImageDir(p, self._loop, self._in_place) if p.is_dir() else files or VideoFrames(p)
         if self._pacer is not None:
             self._pacer.start()
         self._next = 0
@@ -299,7 +252,7 @@ class RecordedSource:
         return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 
     def _fetch(
-        self, reader: Union[_ImageDir, _Video, McapFrames], i: int
+        self, reader: Union[_ImageDir, VideoFrames, McapFrames], i: int
     ) -> Optional[Tuple[int, Optional[np.ndarray]]]:
         for _ in range(2):  # a second try once a video's length has been learned
             length = reader.length
@@ -310,7 +263,7 @@ class RecordedSource:
             else:
                 pos = i
             image = reader.get(pos)
-            if not isinstance(image, _EndOfVideo):
+            if not isinstance(image, EndOfVideo):
                 return pos, image
             if not self._loop:
                 return None
