@@ -158,15 +158,23 @@ def daemon_table(runs: Sequence[DaemonFigures]) -> str:
     rows = []
     for d in runs:
         if d.error:
-            rows.append([f"{d.fps_asked:.0f}", "failed: " + d.error.replace("\n", " ")[:300], *([""] * 9)])
+            rows.append([f"{d.fps_asked:.0f}", "failed: " + d.error.replace("\n", " ")[:300], *([""] * 12)])
             continue
+        pipe = getattr(d, "pipeline_cpu_ms", math.nan)
         rows.append([f"{d.fps_asked:.0f}", f"{d.startup_s:.2f}", f"{d.duration_s:.1f}",
                      f"{d.received} / {d.frames_expected}", d.dropped, d.seq_gaps, f"{d.cpu_pct:.2f}",
                      f"{d.cpu_ms_per_frame:.2f}", f"{d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / "
-                     f"{d.latency_ms_max:.2f}", f"{d.rss_mib:.0f} / {d.rss_peak_mib:.0f}", d.exit_code])
+                     f"{d.latency_ms_max:.2f}", f"{d.rss_mib:.0f} / {d.rss_peak_mib:.0f}", d.exit_code,
+                     f"{pipe:.2f} ({getattr(d, 'tracked_pct', math.nan):.0f} %)",
+                     f"{d.cpu_ms_per_frame - pipe:.2f}", f"{getattr(d, 'clip_mib', math.nan):.0f}"])
     return table(["fps asked", "start-up s (to 1st datagram)", "window s", "datagrams / frames due", "dropped",
                   "seq gaps", "CPU % of a core", "CPU ms per frame", "latency p50 / p99 / max ms",
-                  "RSS / peak MiB", "exit"], rows)
+                  "RSS / peak MiB", "exit", "pipeline CPU ms per frame (tracked)", "rest of the daemon ms per frame",
+                  "recorded clip held MiB"], rows) + (
+        "\n\nThe pipeline's CPU is the daemon's own figure (its final log line, all frames of the run); "
+        "the rest is the daemon around it (source, encoding, sending, stats). Start-up runs with the "
+        "package's bytecode compiled beforehand, as pip installs it. The RSS includes the recorded clip, "
+        "held decoded (BGR and its YUV420) as a camera's buffers would be; a camera source holds none of it.")
 
 
 def _valid(run: Run, key: Key, names: Sequence[str]) -> bool:
