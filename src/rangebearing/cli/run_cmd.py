@@ -11,7 +11,6 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from ..allocator import keep_freed_buffers
 from ..config import Config, check
-from ..daemon.heap import keep_heap
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
 from ..errors import ConfigError
@@ -141,7 +140,6 @@ def run(args: argparse.Namespace) -> int:
             ZenohSettings.from_config(cfg.publish.zenoh).zenoh_config()
         print(f"{cfg.source_file}: OK")
         return 0
-    keep_heap()  # a frame's buffers stay in the heap instead of being page-faulted in anew every frame
     echo = None
     if args.echo or cfg.daemon.echo:
         echo = _echo_json if args.json else _echo_line
