@@ -29,6 +29,7 @@ from .refine import Pyramid
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import reading_sigma
+from .verify import verified
 from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
@@ -143,6 +144,7 @@ class Pipeline:
                     cands = yuv_find_candidates(yuv, det, self._gains, ksize, self.params.landmark, y_half)
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
+                found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close)

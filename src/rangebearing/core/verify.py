@@ -1,0 +1,93 @@
+"""Is a measured candidate a landmark? Checks of properties every real landmark has, in any light.
+
+The structure search (:mod:`.structure`) accepts columns that read red → white →
+blue with the right proportions. Other things read so too: a red wall over a
+grey wall over a navy mat, a robot's dark chassis between a red box and a blue
+one, a neighbour's mast-mounted camera under a band. What they lack, and what
+the checks here ask for:
+
+- **Its own band edges.** A band whose colour runs on past its outer edge
+  (``red_merged``/``blue_merged``: a wall, box or mat of its colour behind it)
+  is placed from its inner edge and the white height. When *both* bands merge,
+  nothing of the candidate is the landmark's own shape: only two colour steps
+  with something light between, which any red surface over a light strip over a
+  blue one shows. Such a candidate is no landmark.
+- **A white body lighter than either band in the band's own channel.** White
+  paint reflects more of every channel than the red or blue paint does (ours:
+  red channel 0.85 against the red paint's 0.70, blue 0.85 against 0.65). The
+  band and the body are one cylinder a few centimetres apart: the same light
+  and, column by column, the same surface normal, so the ratio holds whatever
+  the light's colour or strength. A dark chassis, a mast or a shadowed wall
+  between two coloured things is far darker than the band in its channel.
+  ``BAND_OVER_WHITE`` allows for light that changes along the height (the edge
+  of a spotlight or of a shadow). Robust levels: the brightest tenth of the
+  body (a neighbour's mast or camera in front of it darkens only part) and the
+  upper quartile of each band's core.
+
+Levels are taken in linear light over the middle three fifths of the
+candidate's visible columns (limbs darken and mix with the background). Each
+check compares one channel with itself, so the white balance cancels.
+"""
+
+from __future__ import annotations
+
+from typing import List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .detect import BandCentroids
+from .edges import linear_table
+from .types import LandmarkGeometry
+
+BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
+WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
+SAMPLES = 24  # rows and columns sampled per region, at most
+
+
+def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float], channel: int, pct: float) -> float:
+    """Percentile ``pct`` of one linear-light channel (0 B, 2 R) over a region of the frame."""
+    h, w = bgr.shape[:2]
+    r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
+    c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
+    if r1 <= r0 or c1 <= c0:
+        return float("nan")
+    rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
+    return float(np.percentile(linear_table()[bgr[r0:r1:rs, c0:c1:cs, channel]], pct))
+
+
+def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry) -> Optional[str]:
+    """Why ``c`` is no landmark, or ``None`` when it passes every check (see the module docstring).
+
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        The full-resolution frame the candidate was measured in.
+    c : BandCentroids
+        The measured candidate (its band rows and visible columns).
+    geometry : LandmarkGeometry
+        The landmark's dimensions (band and white heights from the band spacing).
+    """
+    cand = c.candidate
+    if cand is not None and cand.red_merged and cand.blue_merged:
+        return "both bands merge with their backgrounds: no edge of the landmark's own"
+    ry, by = c.red_xy_px[1], c.blue_xy_px[1]
+    spacing = by - ry
+    if spacing <= 0:
+        return "the blue band is not below the red one"
+    band = spacing * geometry.band_height_m / geometry.band_spacing_m
+    white = spacing * (geometry.height_m - 2 * geometry.band_height_m) / geometry.band_spacing_m
+    x, _, w, _ = c.bbox_px
+    cols = (x + 0.2 * w, x + 0.8 * w)
+    red_r = _level(bgr, (ry - 0.25 * band, ry + 0.25 * band), cols, 2, BAND_PCT)
+    blue_b = _level(bgr, (by - 0.25 * band, by + 0.25 * band), cols, 0, BAND_PCT)
+    body = (ry + 0.5 * band + 0.15 * white, by - 0.5 * band - 0.15 * white)
+    white_r = _level(bgr, body, cols, 2, WHITE_PCT)
+    white_b = _level(bgr, body, cols, 0, WHITE_PCT)
+    if red_r > BAND_OVER_WHITE * white_r or blue_b > BAND_OVER_WHITE * white_b:
+        return "the white body is darker than a band in the band's own channel"
+    return None
+
+
+def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry) -> List[BandCentroids]:
+    """The candidates that pass every check of :func:`rejection`, in their order."""
+    return [c for c in found if rejection(bgr, c, geometry) is None]

@@ -1,0 +1,62 @@
+"""False-landmark checks (core/verify.py): hand-made frames whose answer follows from the paints."""
+
+import numpy as np
+import pytest
+
+from rangebearing.core.detect import BandCentroids
+from rangebearing.core.structure import Candidate
+from rangebearing.core.types import LandmarkGeometry
+from rangebearing.core.verify import rejection
+
+GEOMETRY = LandmarkGeometry()
+RED, WHITE, BLUE = (0.70, 0.07, 0.06), (0.85, 0.85, 0.85), (0.06, 0.12, 0.65)  # linear RGB reflectances
+CHASSIS, GREY_WALL = (0.04, 0.04, 0.045), (0.30, 0.30, 0.30)
+# a landmark 40 px wide at columns 20-60: red rows 20-35, body rows 35-75, blue rows 75-90 (15/40/15 mm at 1 px/mm)
+X0, X1, RED_ROWS, BODY_ROWS, BLUE_ROWS = 20, 60, (20, 35), (35, 75), (75, 90)
+
+
+def frame(body=WHITE, light=(1.0, 1.0, 1.0), background=GREY_WALL):
+    """An 8-bit BGR frame of red / ``body`` / blue strips lit by ``light`` (linear RGB), 2.2-encoded."""
+    lin = np.empty((110, 80, 3))
+    lin[:] = background
+    for rows, paint in ((RED_ROWS, RED), (BODY_ROWS, body), (BLUE_ROWS, BLUE)):
+        lin[rows[0] : rows[1], X0:X1] = paint
+    lin = np.clip(lin * light, 0.0, 1.0)
+    return np.round(255.0 * lin[..., ::-1] ** (1 / 2.2)).astype(np.uint8)
+
+
+def found(red_merged=False, blue_merged=False):
+    red_box = (X0, RED_ROWS[0], X1 - X0, RED_ROWS[1] - RED_ROWS[0])
+    blue_box = (X0, BLUE_ROWS[0], X1 - X0, BLUE_ROWS[1] - BLUE_ROWS[0])
+    cand = Candidate(red_box, blue_box, 40.0, red_merged, blue_merged, False, False, 1.0)
+    centre_x = 0.5 * (X0 + X1) - 0.5
+    return BandCentroids((centre_x, 27.0), (centre_x, 82.0), red_box, blue_box, 600.0, 600.0, 90.0, 90.0,
+                         candidate=cand)
+
+
+LIGHTS = [(1.0, 1.0, 1.0), (0.25, 0.25, 0.25), (1.0, 0.7, 0.4), (0.5, 0.7, 1.0)]  # white, dim, warm, cool
+
+
+@pytest.mark.parametrize("light", LIGHTS)
+def test_a_landmark_passes_in_any_light(light):
+    assert rejection(frame(light=light), found(), GEOMETRY) is None
+
+
+@pytest.mark.parametrize("light", LIGHTS)
+@pytest.mark.parametrize("body", [CHASSIS, GREY_WALL], ids=["dark-chassis", "grey-wall"])
+def test_something_darker_than_the_bands_between_them_is_no_white_body(light, body):
+    # a robot's chassis or a grey wall between a red thing and a blue one reads red -> light -> blue in the masks
+    assert "darker" in rejection(frame(body=body, light=light), found(), GEOMETRY)
+
+
+def test_a_mast_in_front_of_part_of_the_white_body_does_not_reject_it():
+    img = frame()
+    img[BODY_ROWS[0] : BODY_ROWS[1], 30:48] = 12  # a neighbour's dark mast covers 45 % of the body's columns
+    assert rejection(img, found(), GEOMETRY) is None
+
+
+def test_one_merged_band_is_still_a_landmark_but_two_are_not():
+    img = frame()
+    assert rejection(img, found(red_merged=True), GEOMETRY) is None
+    assert rejection(img, found(blue_merged=True), GEOMETRY) is None
+    assert "both bands" in rejection(img, found(red_merged=True, blue_merged=True), GEOMETRY)
