@@ -7,7 +7,8 @@ import pytest
 
 from rangebearing import Pipeline, load_config
 from rangebearing.core.edges import limb
-from rangebearing.core.measure import outline_centre
+from rangebearing.core.measure import measure_rows, outline_centre
+from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
 from rangebearing.synth import Imaging, LandmarkPose, Scene, render
 
@@ -68,3 +69,31 @@ def test_a_landmark_cut_by_the_frame_edge_is_placed_from_its_inner_limb(bearing_
     assert lm.visible < 0.9
     assert math.degrees(abs(lm.bearing_rad - bearing_rad)) < 0.15
     assert lm.range_m == pytest.approx(0.3, rel=0.01)
+
+
+def _strips(hidden_rows=0):
+    """A crisp landmark 40 px wide: red rows 20-35, white 35-75, blue 75-90; a dark robot body in front
+    hides the blue band's last ``hidden_rows`` rows."""
+    lin = np.full((120, 80, 3), 0.30)
+    for (r0, r1), rgb in (((20, 35), (0.70, 0.07, 0.06)), ((35, 75), (0.85,) * 3), ((75, 90), (0.06, 0.12, 0.65))):
+        lin[r0:r1, 20:60] = rgb
+    lin[90 - hidden_rows : 110, 10:70] = 0.04
+    return np.round(255.0 * lin[..., ::-1] ** (1 / 2.2)).astype(np.uint8)
+
+
+def _candidate():
+    return Candidate((20, 20, 40, 15), (20, 76, 40, 15), 40.0, False, False, False, False, 1.0)
+
+
+def test_a_whole_band_is_placed_between_its_edges():
+    rows = measure_rows(_strips(), _candidate(), (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert rows.red_y_px == pytest.approx(27.0, abs=0.05) and rows.blue_y_px == pytest.approx(82.0, abs=0.05)
+    assert not rows.blue_merged and rows.blue_px == pytest.approx(15.0, abs=0.1)
+
+
+@pytest.mark.parametrize("hidden_rows", [4, 7])
+def test_a_blue_band_hidden_from_below_is_placed_from_its_inner_edge(hidden_rows):
+    # between its edges the band's centre would be (75 + 90 − hidden)/2: 3.5 px, 6 % of L, too high at 7 rows hidden
+    rows = measure_rows(_strips(hidden_rows), _candidate(), (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert rows.blue_merged
+    assert rows.blue_y_px == pytest.approx(82.0, abs=0.1)

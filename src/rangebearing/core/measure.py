@@ -2,16 +2,19 @@
 
 Rows: each band's two edges by the two-level integral of :mod:`.edges`, over
 the landmark's own columns, so a neighbour beside it does not count. A band
-whose outer edge merges with a same-coloured background is placed from its
-inner edge and the white body's height instead.
+whose outer edge merges with a same-coloured background, or a blue band whose
+lower part a nearer robot hides, is placed from its inner edge and the white
+body's height instead.
 
 Columns: a landmark seen whole is measured by the saturation-weighted moments
 of :mod:`.refine`. One cut on a side (a nearer landmark in front, a neighbour
-touching it) is placed from its other limb, half a silhouette away.
+touching it, the frame's edge) is placed from its other limb, by the tangent
+rays of its outline.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import List, Optional, Sequence, Tuple
 
@@ -19,7 +22,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import Gains
-from .edges import band_rows, excess, limb, linear_table
+from .edges import BandEdges, band_rows, excess, limb, linear_table
 from .refine import Pyramid
 from .structure import Candidate
 from .types import LandmarkGeometry
@@ -29,12 +32,20 @@ LIMB_SIGMA_X_PX = 0.8  # a limb edge on a shaded cylinder side
 OUTLINE_ITERATIONS = 4  # fixed-point steps for the axis angle (each gains about two decimal places)
 LIMB_AGREE_PX = 1.5  # the two bands' limbs of one cylinder agree within this; farther apart, one was widened
 MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
+SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
+WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
 FRAME_EDGE_PX = 2  # a run starting this close to the frame's edge (½-resolution columns) may be cut by it
 
 
 @frozen
 class Rows:
-    """A candidate's band centres (rows, full-resolution pixels) and the white body's height."""
+    """A candidate's band centres (rows, full-resolution pixels) and the white body's height.
+
+    ``red_merged``/``blue_merged``: the band is placed from its inner edge and the
+    white height, because its outer edge is not its own (merged with a background
+    of its colour, or hidden). ``red_px``/``blue_px``: each band's height between
+    its two measured edges (NaN when merged).
+    """
 
     red_y_px: float
     blue_y_px: float
@@ -42,6 +53,8 @@ class Rows:
     sigma_l_px: float
     red_merged: bool
     blue_merged: bool
+    red_px: float = math.nan
+    blue_px: float = math.nan
 
 
 def _tile(bgr: np.ndarray, x0: int, y0: int, x1: int, y1: int, col_step: int = 1, row_step: int = 1):
@@ -170,6 +183,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         return None
     white = blue.inner - red.inner
     k = 0.5 * geometry.band_height_m / white_m
+    if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
+        blue = _hidden(blue, _height(red, True) or 2 * k * white)
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
     sigma = float(np.hypot(red.sigma, blue.sigma)) * (1.0 + (2 * k if red.merged or blue.merged else 0.0))
@@ -180,7 +195,31 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         sigma * f,
         red.merged,
         blue.merged,
+        math.nan if red.merged else 2.0 * (red.inner - red.centre) * f,
+        math.nan if blue.merged else 2.0 * (blue.centre - blue.inner) * f,
     )
+
+
+def _height(band: BandEdges, red: bool) -> float:
+    """A band's height between its two edges (rows); 0 when merged (its outer edge is not its own)."""
+    if band.merged:
+        return 0.0
+    return 2.0 * (band.inner - band.centre) if red else 2.0 * (band.centre - band.inner)
+
+
+def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
+    """The blue band, marked merged when it is seen shorter than ``SHORT_BAND`` of ``expected_px``.
+
+    A nearer robot's body in front hides the lower part of a landmark behind it:
+    the blue band's outer edge is then the occluder's, and the mean of its edges
+    sits too high (L short, range long, by up to ~10 %). Both bands are 15 mm on
+    one cylinder at one depth, so the red band's height (or, when it merged,
+    15/40 of the white body's) is what the blue one should measure. A red band
+    cannot be hidden so: whatever hides its top hides the white body below it.
+    """
+    if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
+        return blue
+    return dataclasses.replace(blue, merged=True)
 
 
 def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool):
