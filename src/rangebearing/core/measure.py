@@ -6,10 +6,9 @@ whose outer edge merges with a same-coloured background, or a blue band whose
 lower part a nearer robot hides, is placed from its inner edge and the white
 body's height instead.
 
-Columns: a landmark seen whole is measured by the saturation-weighted moments
-of :mod:`.refine`. One cut on a side (a nearer landmark in front, a neighbour
-touching it, the frame's edge) is placed from its other limb, by the tangent
-rays of its outline.
+Columns (:mod:`.limbs`, re-exported here): a landmark seen whole is measured
+by the saturation-weighted moments of :mod:`.refine`; one cut on a side is
+placed from its other limb.
 """
 
 from __future__ import annotations
@@ -22,19 +21,13 @@ import numpy as np
 
 from .._compat import frozen
 from .color import Gains
-from .edges import BandEdges, band_rows, excess, limb, linear_table
-from .refine import Pyramid
+from .edges import BandEdges, band_rows, excess
+from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_centre, thin_step
 from .structure import Candidate
 from .types import LandmarkGeometry
 
-CENTROID_SIGMA_X_PX = 0.15  # column centroid of a whole landmark (saturation moments)
-LIMB_SIGMA_X_PX = 0.8  # a limb edge on a shaded cylinder side
-OUTLINE_ITERATIONS = 4  # fixed-point steps for the axis angle (each gains about two decimal places)
-LIMB_AGREE_PX = 1.5  # the two bands' limbs of one cylinder agree within this; farther apart, one was widened
-MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
-FRAME_EDGE_PX = 2  # a run starting this close to the frame's edge (½-resolution columns) may be cut by it
 
 
 @frozen
@@ -55,33 +48,6 @@ class Rows:
     blue_merged: bool
     red_px: float = math.nan
     blue_px: float = math.nan
-
-
-def _tile(bgr: np.ndarray, x0: int, y0: int, x1: int, y1: int, col_step: int = 1, row_step: int = 1):
-    """The frame's region (clipped), every ``col_step``-th column and ``row_step``-th row, and its origin.
-
-    Profiles are means along one axis, so thinning the other keeps them linear in
-    coverage (an area-averaged pyramid averages *encoded* values, which does not).
-    """
-    h, w = bgr.shape[:2]
-    x0, y0, x1, y1 = max(0, x0), max(0, y0), min(w, x1), min(h, y1)
-    return bgr[y0:y1:row_step, x0:x1:col_step], x0, y0
-
-
-def cut_sides(c: Candidate, frame_w_px: int) -> Tuple[bool, bool]:
-    """``(left, right)``: sides of the candidate that are no limb of the cylinder.
-
-    Besides what the structure search saw (a nearer landmark, a touching
-    neighbour), the frame's own edge cuts a landmark: the moments of what is
-    left would place it towards the inside, by up to half a silhouette.
-    """
-    rx, _, rw, _ = c.red_bbox_px
-    return c.cut_left or rx <= FRAME_EDGE_PX, c.cut_right or rx + rw >= frame_w_px - FRAME_EDGE_PX
-
-
-def _step(n: int) -> int:
-    """Thinning that keeps about MAX_SAMPLES of ``n`` lines."""
-    return max(1, n // MAX_SAMPLES)
 
 
 def measure_rows(
@@ -109,7 +75,7 @@ def _row_window(shape: Tuple[int, ...], c: Candidate, geometry: LandmarkGeometry
     whole = cut_sides(c, shape[1]) == (False, False)
     a, b = (x_px - rw / 3, x_px + rw / 3) if x_px is not None and whole else (rx, rx + rw)
     cx0, cx1 = int(np.floor(a + 0.5)), int(np.ceil(b - 0.5)) + 1
-    step = _step(cx1 - cx0)
+    step = thin_step(cx1 - cx0)
     pad = int(band_px) + 6
     h, w = shape[:2]
     x0, y0, x1, y1 = max(0, cx0), max(0, ry - pad), min(w, cx1), min(h, by + bh + pad)
@@ -245,84 +211,6 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
     return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p)
 
 
-def measure_columns(
-    bgr: np.ndarray,
-    c: Candidate,
-    gains: Gains,
-    geometry: LandmarkGeometry,
-    fy_px: float,
-    rows: Rows,
-    pyramid: Optional[Pyramid] = None,
-) -> Optional[Tuple[float, float]]:
-    """``(x_px, sigma_x_px)`` of a landmark cut on exactly one side, from its other limb; else ``None``.
-
-    Both bands' limbs are measured (:func:`.edges.limb`); they are one cylinder's
-    outline, so when they disagree the inner one wins (a same-coloured band beside
-    it only ever widens a band). ``x_px`` is the outline's centre, the column the
-    model expects (:func:`.model.axis_bearing` takes it to the axis), placed from
-    the limb by :func:`outline_centre`.
-    """
-    cut_left, cut_right = cut_sides(c, bgr.shape[1])
-    if cut_left == cut_right:
-        return None
-    white_m = geometry.height_m - 2 * geometry.band_height_m
-    band_px = rows.white_px * geometry.band_height_m / white_m
-    rx, _, rw, _ = c.red_bbox_px
-    cx_px = 0.5 * (bgr.shape[1] - 1)
-    d = fy_px * white_m / max(rows.white_px, 1e-3) + geometry.radius_m
-    half = rows.white_px * geometry.radius_m / white_m * (1.0 - geometry.radius_m / d)
-    reach = round(2 * half) + 4
-    edges = []
-    for y_c, is_red in ((rows.red_y_px, True), (rows.blue_y_px, False)):
-        y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
-        x0, x1 = (rx - 4, rx + rw + reach) if cut_left else (rx - reach, rx + rw + 4)
-        tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=_step(y1 - y0))
-        er, eb = excess(tile, gains)
-        lin_sum = np.maximum(linear_table()[tile].sum(axis=2), 1e-3)
-        q = ((er if is_red else eb) / lin_sum).mean(axis=0)  # chromaticity: shading does not move it
-        n = len(q)
-        if n < 4:
-            continue
-        if cut_left:  # the right limb is natural: start inside, run right
-            core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
-        else:
-            core = max(0, min(n - 1, int(rx - ox) + int(half)))
-        level = float(np.median(q[max(0, core - 2) : core + 3]))
-        edges.append(ox + limb(q, core, n - 1 if cut_left else 0, level))
-    edges = [e for e in edges if math.isfinite(e)]
-    if not edges:
-        return None
-    if len(edges) == 2 and abs(edges[0] - edges[1]) <= LIMB_AGREE_PX:
-        edge = 0.5 * (edges[0] + edges[1])
-    else:
-        edge = min(edges) if cut_left else max(edges)
-    x = outline_centre(edge, cut_left, cx_px, fy_px, rows.white_px, geometry)
-    if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
-        return None
-    return x, LIMB_SIGMA_X_PX
-
-
-def outline_centre(
-    limb_px: float, right: bool, cx_px: float, f_px: float, white_px: float, geometry: LandmarkGeometry
-) -> float:
-    """Image column of the cylinder's outline centre, from one limb's column.
-
-    The outline spans the tangent rays at ``φ ± α`` (φ the axis's angle to the
-    right of the optical axis, α = asin(r/d)), so the other limb lies at
-    ``tan(φ_l ∓ 2α)``: off the axis the outline is wider than ``2·f·r/d`` by about
-    1/cos²φ, which half a silhouette taken from the white height would miss.
-    The range d comes from the white height (measured on the near surface, depth
-    ``(d − r)·cos φ``). The principal point is taken at the frame centre and
-    fx = fy: an error of a few pixels in either changes the result by hundredths
-    of a pixel.
-    """
-    white_m = geometry.height_m - 2 * geometry.band_height_m
-    z_m = f_px * white_m / max(white_px, 1e-3)
-    phi_l = math.atan((limb_px - cx_px) / f_px)
-    phi = phi_l
-    for _ in range(OUTLINE_ITERATIONS):
-        d = z_m / math.cos(phi) + geometry.radius_m
-        alpha = math.asin(min(1.0, geometry.radius_m / d))
-        phi = phi_l - alpha if right else phi_l + alpha
-    other = math.tan(phi - alpha if right else phi + alpha)
-    return cx_px + 0.5 * f_px * (math.tan(phi_l) + other)
+__all__ = [
+    "CENTROID_SIGMA_X_PX", "Rows", "cut_sides", "measure_columns", "measure_rows", "measure_rows_all", "outline_centre",
+]
