@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rangebearing.core.color import to_hsv
-from rangebearing.core.structure import candidates, column_edges, region_pairs, region_stats, runs
+from rangebearing.core.structure import MAX_REGIONS, candidates, column_edges, region_pairs, region_stats, runs
 from rangebearing.core.types import LandmarkGeometry
 
 RED, BLUE, WHITE, GREY = (40, 40, 200), (200, 60, 30), (220, 220, 220), (120, 120, 120)
@@ -117,8 +117,11 @@ def test_the_search_is_bounded_by_max_landmarks_and_the_region_cap():
         for j in range(12):
             landmark(img, 10 + 52 * j, 5 + 58 * i, 6, 14)
     assert len(search(img, max_landmarks=16)) == 16
-    reds = region_stats(((to_hsv(img)[..., 1] > 90) & (to_hsv(img)[..., 0] < 10)).astype(np.uint8) * 255, 2)
-    assert len(reds) == 48  # the largest 48 of 96 regions
+    specks = np.zeros((480, 640), np.uint8)
+    specks[2::6, 2::6] = 255  # 80 x 107 one-pixel specks ...
+    specks[100:103, 100:104] = 255  # ... and one region larger than all of them
+    reds = region_stats(specks, 1)
+    assert len(reds) == MAX_REGIONS and reds[:, 5].max() == 12  # the largest regions, that one included
     assert len(region_pairs(reds, reds, 10)) <= 10
 
 

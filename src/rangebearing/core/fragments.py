@@ -77,11 +77,24 @@ def split_runs(
 
     A run whose band runs on past ``merged_k`` band heights (plus one) is merged with a same-coloured
     background and kept whole, as a wide run with a merged band is never split at one range either.
+    Only runs wider than ``WIDE`` silhouettes of their tallest column are looked at (few are).
     """
+    if not found:
+        return []
+    s0 = np.fromiter((f[0] for f in found), np.int64, len(found))
+    s1 = np.fromiter((f[1] for f in found), np.int64, len(found))
+    g = e2 - e1 - 1.0
+    inside = np.zeros(len(g) + 1, np.int64)
+    np.add.at(inside, s0, 1)
+    np.add.at(inside, s1, -1)
+    tallest = np.maximum.reduceat(np.where(np.cumsum(inside[:-1]) > 0, g, -np.inf), s0)
+    wide = (s1 - s0 >= 2 * MIN_PIECE) & (s1 - s0 > WIDE * width_k * tallest)
+    if not wide.any():
+        return list(found)
     out: List[Tuple[int, int]] = []
-    for r0, r1 in found:
-        hb = band_k * float(np.median(e2[r0:r1] - e1[r0:r1] - 1))
-        if max(float(np.median(run_r[r0:r1])), float(np.median(run_b[r0:r1]))) > merged_k * hb + 1:
+    for (r0, r1), look in zip(found, wide.tolist()):
+        hb = band_k * float(np.median(g[r0:r1])) if look else 0.0
+        if not look or max(float(np.median(run_r[r0:r1])), float(np.median(run_b[r0:r1]))) > merged_k * hb + 1:
             out.append((r0, r1))
             continue
         out.extend((r0 + a, r0 + b) for a, b in height_steps(e1[r0:r1], e2[r0:r1], width_k))

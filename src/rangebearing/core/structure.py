@@ -34,10 +34,10 @@ import numpy as np
 
 from .._compat import frozen
 from .columns import bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
-from .fragments import Fragment, join_fragments, lit_like_bands, split_runs
+from .fragments import MIN_PIECE, Fragment, join_fragments, lit_like_bands, split_runs
 from .types import BBox, LandmarkGeometry
 
-MAX_REGIONS = 48  # largest regions of each colour considered (bounds the cost of a frame full of specks)
+MAX_REGIONS = 128  # largest regions of each colour considered (bounds the cost of a frame full of specks)
 MAX_PAIRS_PER_LANDMARK = 4  # region pairs examined per landmark wanted
 MERGED = 1.7  # a band run longer than this many expected band heights is merged with something
 SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
@@ -148,7 +148,9 @@ def candidates(
         (float(x0 + s0), float(x0 + s1), med_1 + y0, med_2 + y0, gap, med_r, med_b)
         for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins, split))
         for s0, s1, gap, med_r, med_b, med_1, med_2 in found
+        if s1 - s0 >= MIN_PIECE  # a column of edge noise neither makes nor joins a landmark
     ]
+    frags = list(dict.fromkeys(frags))  # one structure is often found whole in several windows
     for c0f, c1f, ey1, ey2, gap, med_r, med_b in join_fragments(frags, red, blue, band_k, width_k):
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0
