@@ -60,7 +60,10 @@ SETS: Tuple[Tuple[str, str, int, bool], ...] = (
     ("clutter", "jpg", 1, False),
     ("multi", "png", 1, False),
     ("crowd-moving", "png", 5, True),
+    ("photoreal", "png", 1, False),  # not in the default --sets: the Pi camera's lens and ISP (synth docs)
+    ("photoreal-crowd", "png", 1, False),
 )
+DEFAULT_SETS = tuple(s[0] for s in SETS if not s[0].startswith("photoreal"))
 # issue 8: found share of findable landmarks; paper/wide/clutter/multi keep the core issue's bounds
 MIN_FOUND = {"occlusion": 97.0, "touching": 97.0, "crowd": 97.0, "far": 99.0, "lighting": 97.0,
              "paper": 100.0, "wide": 97.0, "clutter": 100.0, "multi": 97.0}
@@ -222,7 +225,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--seed-base", type=int, default=6100, help="set i (1-based, table order) gets seed BASE+i")
     p.add_argument("--frames", type=int, default=60, help="frames per set (crowd-moving: 5x); default 60")
-    p.add_argument("--sets", default=",".join(names), help=f"comma-separated subset of {','.join(names)}")
+    p.add_argument("--sets", default=",".join(DEFAULT_SETS),
+                   help=f"comma-separated subset of {','.join(names)} (default: all but photoreal*)")
     p.add_argument("--workdir", help="cache folder for the rendered sets and the config (reused when present)")
     p.add_argument("--json", metavar="FILE", help="also write the rows (raw figures, misses) as JSON")
     p.add_argument("--config", metavar="FILE", help="replay with this config; skip the calibration")

@@ -34,6 +34,7 @@ from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
 from .structure import Candidate, candidates
 from .types import XY, BBox, LandmarkGeometry, union
+from .uncertainty import row_spread_px
 
 
 @frozen
@@ -50,6 +51,7 @@ class BandCentroids:
     blue_chroma: float
     sigma_l_px: float = 0.0  # one-sigma uncertainty of the band spacing L (full-resolution pixels)
     sigma_x_px: float = 0.0  # ... and of the landmark's image column
+    spread_l_px: float = 0.0  # ... of L from its row estimators' disagreement (uncertainty.row_spread_px)
     visible: float = 1.0  # share of the landmark's silhouette seen
     candidate: Optional[Candidate] = None  # what the structure search found (tracking measures it again)
 
@@ -171,6 +173,8 @@ def combine(
         blue.chroma_ref,
         sigma_l_px=rows.sigma_l_px,
         sigma_x_px=sx,
+        spread_l_px=row_spread_px(red.xy_px[1], rows.red_y_px, rows.red_merged,
+                                  blue.xy_px[1], rows.blue_y_px, rows.blue_merged),
         visible=c.visible,
         candidate=c,
     )

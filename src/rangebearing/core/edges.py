@@ -120,14 +120,31 @@ def _level_beyond(p: np.ndarray, row: int, down: bool, rows: int = BG_ROWS) -> f
 
 
 def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, down: bool) -> float:
-    """Standard error of the inner edge from the scatter of the per-column edges (rows)."""
-    cols = p2d.shape[1]
-    if cols < 3:
-        return 0.5
+    """Standard error of the inner edge from the scatter of the per-column edges (rows).
+
+    Each column's edge is its own two-level integral (its own band level and
+    background: shading across the cylinder and the profile's weighting of the end
+    columns scale a column, they do not move its edge), and the scatter is taken
+    about a parabola through them: seen from below or above the band, an edge is
+    an arc of an ellipse, a smooth curve that is no noise.
+    """
     lo, hi = (mid, end) if down else (end, mid)
-    sums = (p2d[lo : hi + 1] - bg).sum(axis=0) / (level - bg)
-    dev = sums - np.float32(float(sums.sum()) / cols)  # np.std(sums, ddof=1), its float32 steps
-    return float(np.sqrt(np.float32(float((dev * dev).sum()) / (cols - 1))) / np.sqrt(cols))
+    beyond = p2d[end : end + BG_ROWS] if down else p2d[max(0, end - BG_ROWS + 1) : end + 1]
+    lev = p2d[max(0, mid - 1) : mid + 2].mean(axis=0)
+    bgc = beyond.mean(axis=0) if beyond.size else np.full(p2d.shape[1], bg, np.float32)
+    step = lev - bgc
+    ok = step > 0.5 * (level - bg)
+    cols = int(ok.sum())
+    if cols < 5:
+        return 0.5
+    sums = (p2d[lo : hi + 1, ok] - bgc[ok]).sum(axis=0) / step[ok]
+    x = np.flatnonzero(ok).astype(np.float64)
+    x -= x.mean()
+    x2 = x * x
+    x2 -= x2.mean()
+    a = np.stack([x, x2 - x * (x @ x2) / (x @ x)])  # orthogonal to each other and to the constant
+    res = sums - sums.mean() - (a @ sums / np.einsum("ij,ij->i", a, a)) @ a
+    return float(np.sqrt((res @ res) / (cols - 3)) / np.sqrt(cols))
 
 
 LIMB_BLUR_PX = 3  # columns a limb's edge may be spread over (optics, sensor, the ½-resolution search)

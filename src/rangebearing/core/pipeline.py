@@ -169,7 +169,9 @@ class Pipeline:
         rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, model, self.params.landmark)
         c_m = model.c_m if model.kind == "pinhole" else 0.0
         width_px = c.width_px
-        s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px)
+        cut_both = c.candidate is not None and c.candidate.cut_left and c.candidate.cut_right
+        s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px,
+                                 c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut_both)
         return (rng, bearing, d_v, d_h, l_px, c.red_xy_px, c.blue_xy_px, width_px, c.bbox_px,
                 in_envelope(rng, bearing, model), s_r, s_b, c.visible)
 

@@ -1,0 +1,93 @@
+"""The per-reading sigma: each term moves it the way the measurement says, and the pipeline fills it in."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rangebearing import Config, Pipeline
+from rangebearing.core import uncertainty as u
+from rangebearing.synth import LandmarkPose, Scene, render
+
+
+def test_row_spread_is_half_the_disagreement_of_the_two_estimators_per_band():
+    assert u.row_spread_px(10.0, 10.0, False, 50.0, 50.0, False) == 0.0
+    # independent errors: the mean of a and b has variance E[(a - b)^2] / 4
+    assert u.row_spread_px(10.4, 10.0, False, 50.0, 50.0, False) == pytest.approx(0.2)
+    assert u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False) == pytest.approx(math.hypot(0.2, 0.15))
+    # a merged band's moment is not its own: its term is the inner-edge placement's
+    assert u.row_spread_px(30.0, 10.0, True, 50.0, 50.0, False) == pytest.approx(u.MERGED_PX)
+
+
+def test_range_sigma_follows_the_spacing_error_through_the_model():
+    base = u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0)
+    assert base > 0
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, spread_l_px=0.3) > base
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 0.7) > base  # partly hidden
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 1.0, 1.0) > base  # noisier edges
+    # dominated by the spacing term, sigma/range grows like (d - c)/L: double range, half L, four times
+    far = u.range_sigma_m(2.0, 0.0, 15.0, 2.0, 1.0, 1.0)
+    near = u.range_sigma_m(1.0, 0.0, 30.0, 2.0, 1.0, 1.0)
+    assert far / near == pytest.approx(4.0, rel=0.02)
+    # never below the model's own error after calibration
+    assert u.range_sigma_m(0.5, 0.014, 100.0, 0.0, 1.0) >= u.MODEL_FLOOR * 0.5
+
+
+def test_bearing_sigma_grows_with_band_disagreement_hiding_and_splitting():
+    base = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0)
+    assert base >= u.BEARING_FLOOR_RAD
+    assert u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, spread_x_px=1.0) > base
+    assert u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, visible=0.6) > base
+    split = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut_both=True)
+    assert split > base
+    # off axis a pixel is a smaller angle (cos^2)
+    assert u.bearing_sigma_rad(0.5, 2.0, 30.0, 634.0) < u.bearing_sigma_rad(0.0, 2.0, 30.0, 634.0)
+
+
+def test_pipeline_readings_carry_sigmas_that_grow_with_sensor_noise():
+    cfg = Config()
+    clean = Scene(landmarks=(LandmarkPose(0.8, 0.1),))
+    noisy = Scene(landmarks=(LandmarkPose(0.8, 0.1),), imaging=clean.imaging.__class__(
+        blur_sigma_px=0.8, read_noise=0.05, shot_noise=0.008))
+    pipe = Pipeline(cfg.pipeline, track=False)
+    sig = {}
+    for name, scene in (("clean", clean), ("noisy", noisy)):
+        rs, bs = [], []
+        for seed in range(3):
+            (lm,) = pipe.process(render(scene, np.random.default_rng(seed))).landmarks
+            assert lm.range_sigma_m > 0 and lm.bearing_sigma_rad > 0
+            rs.append(lm.range_sigma_m)
+            bs.append(lm.bearing_sigma_rad)
+        sig[name] = (np.median(rs), np.median(bs))
+    assert sig["noisy"][0] > 1.15 * sig["clean"][0]
+    assert sig["noisy"][1] > 1.1 * sig["clean"][1]
+
+
+def test_column_scatter_is_noise_not_the_edges_curve_or_the_shading():
+    """A noiseless landmark's edges curve (an ellipse seen from below) and shade across the cylinder:
+    neither is scatter. Noise is."""
+    import rangebearing.core.edges as edges
+
+    seen = []
+    orig = edges._column_sigma
+
+    def spy(*args):
+        seen.append(orig(*args))
+        return seen[-1]
+
+    pipe = Pipeline(Config().pipeline, track=False)
+    out = {}
+    for noise in (0.0, 0.03):
+        seen.clear()
+        scene = Scene(landmarks=(LandmarkPose(0.6, -0.2),), imaging=Scene().imaging.__class__(
+            blur_sigma_px=0.6, read_noise=noise))
+        edges._column_sigma = spy
+        try:
+            assert pipe.process(render(scene, np.random.default_rng(4))).landmarks
+        finally:
+            edges._column_sigma = orig
+        out[noise] = max(seen)
+    assert out[0.0] < 0.03  # px: the smooth curve and the shading are taken out
+    assert out[0.03] > 3 * out[0.0]
