@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from rangebearing.core.color import apply_gains, grey_world_gains, hue_mask, to_hsv
+from rangebearing.core.color import apply_gains, class_masks, clipped_mask, grey_world_gains, hue_mask, to_hsv
 
 RED_HUE = ((0, 10), (165, 179))
 BLUE_HUE = ((98, 132),)
@@ -79,3 +79,20 @@ def test_a_clipped_highlight_on_a_band_keeps_its_class():
     hsv = to_hsv(patch((190, 200, 255)))  # a red band in a spotlight: red clipped, saturation ~0.25
     assert (hue_mask(hsv, RED_HUE, 90, 25) == 255).all()
     assert not (hue_mask(to_hsv(patch((190, 200, 240))), RED_HUE, 90, 25) == 255).any()  # unclipped: too pale
+
+
+def test_a_band_clipped_before_the_gains_stays_clipped():
+    # a red band in a spotlight (red clipped) in a frame balanced towards blue: the red gain
+    # pulls 252 to 224, under the clipped threshold, but the pixel is still clipped
+    band = patch((150, 160, 252))
+    gains = (1.117, 1.022, 0.887)
+    hsv = to_hsv(apply_gains(band, gains))
+    red, _ = class_masks(hsv, RED_HUE, BLUE_HUE, 90, 25)
+    assert not red.any()  # judged on the balanced pixel alone it is too pale
+    red, _ = class_masks(hsv, RED_HUE, BLUE_HUE, 90, 25, clipped_mask(band))
+    assert (red == 255).all()
+
+
+def test_only_pixels_with_a_channel_at_250_or_more_are_clipped():
+    frame = np.array([[(150, 160, 252), (249, 249, 249), (250, 10, 10), (0, 0, 0)]], np.uint8)
+    assert clipped_mask(frame).tolist() == [[255, 0, 255, 0]]

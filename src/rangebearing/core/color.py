@@ -7,7 +7,7 @@ All functions take and return numpy arrays and do no I/O. Hue follows OpenCV's
 from __future__ import annotations
 
 import functools
-from typing import Sequence, Tuple
+from typing import Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -115,18 +115,35 @@ def hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
     return cv2.LUT(h, hue_table(tuple(map(tuple, hue_ranges))))
 
 
-def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int) -> np.ndarray:
+def clipped_mask(bgr: np.ndarray) -> np.ndarray:
+    """0/255 mask of pixels with any channel at ``CLIPPED`` or above, of a BGR uint8 image *before* its gains.
+
+    A gain below one scales a clipped channel under the threshold (a red band in
+    a spotlight, (150, 160, 252) BGR, becomes (167, 163, 224)), yet it stays a
+    lower bound of the light: the pixel is still clipped, and :func:`sv_gate`
+    must know it.
+    """
+    _, over = cv2.threshold(bgr, CLIPPED - 1, 255, cv2.THRESH_BINARY)
+    b, g, r = cv2.split(over)
+    return cv2.max(cv2.max(b, g), r)
+
+
+def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int, clipped: Optional[np.ndarray] = None) -> np.ndarray:
     """0/255 mask of S ≥ s_min and V ≥ v_min; where V is clipped (≥ 250), S ≥ s_min/2 suffices.
 
     A clipped pixel has lost part of its chroma to saturation of the sensor
     (a band in a spotlight reads (255, 200, 190)): its hue is still right but
-    its saturation is lower than the paint's.
+    its saturation is lower than the paint's. ``clipped`` (0/255, optional)
+    marks more pixels as clipped: those clipped before the white-balance gains
+    (:func:`clipped_mask`).
     """
     _, s_ok = cv2.threshold(s, s_min - 1, 255, cv2.THRESH_BINARY)
     _, v_ok = cv2.threshold(v, v_min - 1, 255, cv2.THRESH_BINARY)
     _, s_half = cv2.threshold(s, s_min // 2 - 1, 255, cv2.THRESH_BINARY)
-    _, clipped = cv2.threshold(v, CLIPPED - 1, 255, cv2.THRESH_BINARY)
-    return cv2.bitwise_or(cv2.bitwise_and(s_ok, v_ok), cv2.bitwise_and(s_half, clipped))
+    _, clip = cv2.threshold(v, CLIPPED - 1, 255, cv2.THRESH_BINARY)
+    if clipped is not None:
+        clip = cv2.max(clip, clipped)
+    return cv2.bitwise_or(cv2.bitwise_and(s_ok, v_ok), cv2.bitwise_and(s_half, clip))
 
 
 def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> np.ndarray:
@@ -139,11 +156,13 @@ def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> 
 
 
 def class_masks(
-    hsv: np.ndarray, red_hue: HueRanges, blue_hue: HueRanges, s_min: int, v_min: int
+    hsv: np.ndarray, red_hue: HueRanges, blue_hue: HueRanges, s_min: int, v_min: int,
+    clipped: Optional[np.ndarray] = None,
 ) -> Tuple[np.ndarray, np.ndarray]:
-    """The red and the blue :func:`hue_mask` of one image, sharing the channel split and S/V gate."""
+    """The red and the blue :func:`hue_mask` of one image, sharing the channel split and S/V gate
+    (``clipped``: see :func:`sv_gate`)."""
     h, s, v = cv2.split(hsv)
-    sv = sv_gate(s, v, s_min, v_min)
+    sv = sv_gate(s, v, s_min, v_min, clipped)
     return cv2.bitwise_and(hue_in(h, red_hue), sv), cv2.bitwise_and(hue_in(h, blue_hue), sv)
 
 

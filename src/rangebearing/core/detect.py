@@ -27,7 +27,7 @@ import numpy as np
 
 from .._compat import frozen
 from .blobs import mask_centroid
-from .color import Gains, apply_gains, class_masks, hue_mask, to_hsv
+from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, to_hsv
 from .denoise import majority_filter, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
@@ -75,8 +75,13 @@ def downscale(bgr: np.ndarray, s: int) -> np.ndarray:
 def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int) -> Tuple[np.ndarray, np.ndarray]:
     """Filtered red and blue masks of a downscaled frame: balance, HSV, thresholds, majority filter."""
     hsv = to_hsv(apply_gains(small, gains))
-    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
     return majority_filter(red, ksize), majority_filter(blue, ksize)
+
+
+def _clipped(small: np.ndarray, gains: Gains) -> Optional[np.ndarray]:
+    """Pixels clipped before the gains, when a gain below one may have hidden it (else ``None``)."""
+    return clipped_mask(small) if min(gains) < 0.98 else None
 
 
 SPACING_AGREE = (0.8, 1.25)  # band spacing / (white height · 55/40) of a real landmark
@@ -88,7 +93,7 @@ def find_candidates(
 ) -> List[Candidate]:
     """Landmark candidates in a frame downscaled by ``cfg.downscale`` (see :mod:`.structure`)."""
     hsv = to_hsv(apply_gains(small, gains))
-    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
     red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
     return candidates(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)

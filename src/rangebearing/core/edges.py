@@ -28,6 +28,7 @@ from .color import Gains
 
 GAMMA = 2.2
 BG_ROWS = 4  # rows averaged for a background level
+STEP_MIN, STEP_SHARE, STEP_NOISE = 0.02, 0.3, 0.005  # see step_floor
 MERGE_CONTRAST = 0.5  # an outer edge whose level step is below this share of the band's level is merged
 
 
@@ -95,7 +96,7 @@ def band_rows(
     white_end = min(n - 1, max(0, white_end))
     outer_end = min(n - 1, max(0, outer_end))
     w_bg = _level_beyond(p, white_end, inner_down)
-    if level - w_bg <= 0.02:  # no colour step at the white body: not a band
+    if level - w_bg <= step_floor(level):  # no colour step at the white body: not a band
         return None
     if inner_down:
         inner = edge_down(p, mid, white_end, level, w_bg)
@@ -110,6 +111,12 @@ def band_rows(
     centre = 0.5 * (inner + outer)
     sigma = _column_sigma(p2d, level, w_bg, mid, white_end, inner_down)
     return BandEdges(centre, inner, merged, sigma)
+
+
+def step_floor(level: float) -> float:
+    """The smallest colour step at the white body that makes a band: 0.02 in linear light, less for
+    a dark band (dim light, a backlit landmark), down to 30 % of its own level but not into the noise."""
+    return min(STEP_MIN, max(STEP_NOISE, STEP_SHARE * level))
 
 
 def _level_beyond(p: np.ndarray, row: int, down: bool, rows: int = BG_ROWS) -> float:

@@ -195,8 +195,12 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
     if hi <= lo:
         return None
     prof = p[lo:hi]  # rows' means do not depend on the other rows
-    top = int(np.argmax(prof))
-    strong = prof >= 0.5 * prof[top]
+    # seed on the band-sized run of strongest colour, not the strongest row: a bright background
+    # beyond the outer edge leaves a one-row demosaic fringe that can beat the band's own level
+    k = max(1, int(0.5 * hb + 0.5))
+    smooth = np.convolve(prof, np.full(k, 1.0 / k, np.float32), mode="same") if k > 1 else prof
+    top = int(np.argmax(smooth))
+    strong = prof >= 0.5 * smooth[top]
     first, last = top, top  # the band's rows: the run of strong colour around the strongest row
     while first > 0 and strong[first - 1]:
         first -= 1
