@@ -33,6 +33,9 @@ from .verify import verified
 from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
+# no reading beyond this: the search is built for landmarks out to SEARCH_RANGE_M, and a red-white-blue
+# structure far smaller than that landmark is sensor noise or texture more often than a landmark
+MAX_RANGE_M = 1.25 * SEARCH_RANGE_M
 
 
 class Pipeline:
@@ -147,8 +150,10 @@ class Pipeline:
                 found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
-        # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close)
-        readings = sorted((r for r in map(self._reading, found, [cam] * len(found)) if r[0] > 0), key=_range)
+        # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
+        # nor is one beyond MAX_RANGE_M
+        readings = sorted((r for r in map(self._reading, found, [cam] * len(found)) if 0 < r[0] <= MAX_RANGE_M),
+                          key=_range)
         if not self.ids:
             return FrameResult(landmarks=tuple(Landmark(*r) for r in readings), tracked=tracked)
         # the identity filter's own call (identify() would build every Landmark a second time to add the ids)
