@@ -18,14 +18,16 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
+from .balance import balanced_search
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, detect_paper, downscale, find_candidates, refine
+from .detect import BandCentroids, detect_paper, downscale, drop_stacked, find_candidates, refine
 from .identity import IdentityState, empty_state, update
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
+from .structure import Candidate
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import reading_sigma
@@ -139,15 +141,23 @@ class Pipeline:
                 yuv = search if search is not None and det.downscale == 2 and search.y.shape == (h, w) else None
                 small = downscale(bgr, det.downscale) if yuv is None else None
                 y_half = half_luma(yuv.y) if yuv is not None else None
+                geometry = self.params.landmark
+
+                def find(gains: Gains) -> List[Candidate]:
+                    if yuv is None:
+                        return find_candidates(small, det, gains, ksize, geometry)
+                    return yuv_find_candidates(yuv, det, gains, ksize, geometry, y_half)
+
                 if det.white_balance == "grey_world":
-                    self._gains = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
-                if yuv is None:
-                    cands = find_candidates(small, det, self._gains, ksize, self.params.landmark)
+                    grey = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
+                    # measured with the gains of the landmarks' own white bodies (see core/balance.py)
+                    cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks)
                 else:
-                    cands = yuv_find_candidates(yuv, det, self._gains, ksize, self.params.landmark, y_half)
+                    cands = find(self._gains)
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
+                found = drop_stacked(found)  # nor one standing under another (that robot's body)
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),

@@ -1,0 +1,123 @@
+"""White balance from the landmarks themselves: their white bodies are the one surface known to be neutral.
+
+Grey-world (:func:`.color.grey_world_gains`) assumes the frame's near-neutral
+surfaces average to grey. A muted red wall or a brown floor filling most of
+the view breaks that: the gains neutralise the wall (R × 0.6, B × 1.45) and
+turn the white body blue, so the structure search sees no white between the
+bands. A partly corrected tungsten or LED light breaks the camera's own
+balance the other way. Neither can be told from the other by frame
+statistics, but both leave a landmark findable under one of the two. So:
+
+1. search under the grey-world gains and, when they are not near one, also
+   under the camera's own balance (unit gains); keep every landmark either
+   search finds (:func:`merge_candidates`);
+2. measure with the gains that make the found landmarks' white bodies
+   neutral (:func:`white_body_gains`): it is the light *on the landmarks*
+   that decides their band colours, not the frame's average.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from .color import CLIPPED, DARK, UNIT_GAINS, Gains
+from .structure import Candidate
+
+NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
+MIN_WHITE_PX = 12  # unclipped, not dark pixels of white body needed for a landmark to vote
+SAMPLES = 16  # rows and columns sampled per white body (the median needs no more)
+
+
+def near_unit(gains: Gains, tol: float = NEAR_UNIT) -> bool:
+    """Whether every gain is within ``tol`` of one."""
+    return all(abs(g - 1.0) <= tol for g in gains)
+
+
+def _same(a: Candidate, b: Candidate) -> bool:
+    """Whether two candidates' red bands share more than half of the smaller one (one landmark)."""
+    ax, ay, aw, ah = a.red_bbox_px
+    bx, by, bw, bh = b.red_bbox_px
+    w = min(ax + aw, bx + bw) - max(ax, bx)
+    h = min(ay + ah, by + bh) - max(ay, by)
+    return w > 0 and h > 0 and w * h > 0.5 * min(aw * ah, bw * bh)
+
+
+def merge_candidates(first: Sequence[Candidate], more: Sequence[Candidate], max_landmarks: int) -> List[Candidate]:
+    """``first``, then those of ``more`` that are no landmark of ``first``, at most ``max_landmarks`` in all."""
+    out = list(first[:max_landmarks])
+    for c in more:
+        if len(out) >= max_landmarks:
+            break
+        if not any(_same(c, o) for o in out):
+            out.append(c)
+    return out
+
+
+def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
+    """Median (B, G, R) of a candidate's white body, or ``None`` when too little of it is usable.
+
+    The inner half of its columns (limbs are shaded and mixed with the
+    background) and the middle two thirds of the rows between the bands; clipped
+    pixels (a channel ≥ 250: the ratio is lost) and dark ones (max < 20) are
+    left out. The median ignores a flag or mast in front of part of the body.
+    """
+    rx, ry, rw, rh = c.red_bbox_px
+    top, bottom = ry + rh, c.blue_bbox_px[1]
+    h, w = bottom - top, rw
+    if h < 3 or w < 2:
+        return None
+    y0, y1 = top + h // 6, bottom - h // 6
+    x0, x1 = rx + w // 4, rx + w - w // 4
+    y0, y1, x0, x1 = max(0, y0), min(bgr.shape[0], y1), max(0, x0), min(bgr.shape[1], x1)
+    if y1 <= y0 or x1 <= x0:
+        return None
+    sy, sx = max(1, (y1 - y0) // SAMPLES), max(1, (x1 - x0) // SAMPLES)
+    px = bgr[y0:y1:sy, x0:x1:sx].reshape(-1, 3)
+    top_ch = px.max(axis=1)
+    px = px[(top_ch >= DARK) & (top_ch < CLIPPED)]
+    if len(px) < MIN_WHITE_PX:
+        return None
+    return np.median(px, axis=0)
+
+
+def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float = 2.0) -> Optional[Gains]:
+    """Gains ``(g_b, g_g, g_r)`` that make the candidates' white bodies grey; ``None`` without a usable one.
+
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        The full-resolution frame the candidates' boxes refer to.
+    cands : sequence of Candidate
+        Landmarks found by the structure search.
+    limit : float
+        Gains are clipped to ``[1/limit, limit]``, as grey-world's are.
+
+    Notes
+    -----
+    Each landmark's white body gives its median colour (:func:`white_body_colour`);
+    the median over landmarks is made grey at its own mean level. A false
+    candidate's "white body" (a pale bumper, a wall) is near-neutral too, and
+    one landmark out of three cannot move a median.
+    """
+    colours = [col for col in (white_body_colour(bgr, c) for c in cands) if col is not None]
+    if not colours:
+        return None
+    mean = np.maximum(np.median(np.asarray(colours, np.float64), axis=0), 1.0)
+    gains = np.clip(mean.mean() / mean, 1.0 / limit, limit)
+    return tuple(float(g) for g in gains)  # type: ignore[return-value]
+
+
+def balanced_search(
+    find: Callable[[Gains], List[Candidate]], bgr: np.ndarray, gains: Gains, max_landmarks: int
+) -> Tuple[List[Candidate], Gains]:
+    """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too;
+    and the gains to measure them with: their white bodies', else ``gains``.
+
+    ``find(gains)`` is the structure search of this frame (BGR or YUV path).
+    """
+    cands = find(gains)
+    if not near_unit(gains):
+        cands = merge_candidates(cands, find(UNIT_GAINS), max_landmarks)
+    return cands, white_body_gains(bgr, cands) or gains

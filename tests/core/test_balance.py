@@ -1,0 +1,86 @@
+"""White balance from the landmarks' own white bodies, and the two-hypothesis search."""
+
+import numpy as np
+import pytest
+
+from rangebearing.core.balance import balanced_search, merge_candidates, near_unit, white_body_gains
+from rangebearing.core.structure import Candidate
+
+
+def cand(x, y=40, w=20, band=8, white=24):
+    """A candidate whose red band is at (x, y), white body below it, then the blue band."""
+    return Candidate((x, y, w, band), (x, y + band + white, w, band), float(white), False, False, False, False, 1.0)
+
+
+def frame_with_body(body_bgr, wall_bgr=(40, 60, 170), c=None):
+    img = np.full((120, 160, 3), wall_bgr, np.uint8)  # a muted red wall over the whole frame
+    c = c or cand(60)
+    x, y, w, h = c.red_bbox_px
+    img[y + h : c.blue_bbox_px[1], x : x + w] = body_bgr
+    return img, c
+
+
+def test_a_white_body_under_a_warm_cast_gives_the_gains_that_neutralise_it():
+    img, c = frame_with_body((120, 160, 200))  # white under tungsten light
+    g = white_body_gains(img, [c])
+    body = np.array([120, 160, 200]) * np.array(g)
+    assert body.max() - body.min() < 1.0
+    assert g[0] > 1.0 > g[2]
+
+
+def test_a_flag_in_front_of_part_of_the_body_does_not_move_the_median():
+    img, c = frame_with_body((180, 180, 180))
+    x, y, _, h = c.red_bbox_px
+    img[y + h + 8 : y + h + 14, x + 4 : x + 12] = (30, 120, 30)  # a green flag over a quarter of the body
+    assert white_body_gains(img, [c]) == pytest.approx((1.0, 1.0, 1.0), abs=0.01)
+
+
+def test_clipped_and_dark_bodies_do_not_vote():
+    img, c = frame_with_body((255, 255, 255))
+    assert white_body_gains(img, [c]) is None
+    img, c = frame_with_body((8, 10, 12))
+    assert white_body_gains(img, [c]) is None
+    assert white_body_gains(img, []) is None
+
+
+def test_candidates_of_the_second_search_are_added_once():
+    a, b, c = cand(10), cand(60), cand(62)  # c is b found again, two pixels over
+    assert merge_candidates([a], [b, c], 8) == [a, b]
+    assert merge_candidates([a, b], [c], 8) == [a, b]
+    assert merge_candidates([a], [b], 1) == [a]
+
+
+def test_the_camera_balance_is_searched_too_when_grey_world_pulls_far_from_one():
+    img, c = frame_with_body((150, 150, 150))
+    seen = []
+
+    def find(gains):
+        seen.append(gains)
+        return [c] if near_unit(gains) else []  # found only under the camera's own balance
+
+    cands, gains = balanced_search(find, img, (1.45, 1.29, 0.60), 8)
+    assert cands == [c] and seen == [(1.45, 1.29, 0.60), (1.0, 1.0, 1.0)]
+    assert gains == pytest.approx((1.0, 1.0, 1.0), abs=0.01)  # the body is grey: measured without a cast
+    seen.clear()
+    cands, gains = balanced_search(find, img, (1.01, 1.0, 0.99), 8)
+    assert cands == [c] and len(seen) == 1  # near one: one search
+
+
+def bands(x, y, spacing=40.0, w=20):
+    from rangebearing.core.detect import BandCentroids
+
+    box_r, box_b = (x - w // 2, int(y) - 5, w, 10), (x - w // 2, int(y + spacing) - 5, w, 10)
+    return BandCentroids((x, y), (x, y + spacing), box_r, box_b, 100.0, 100.0, 50.0, 50.0)
+
+
+def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
+    from rangebearing.core.detect import drop_stacked
+
+    top, plate = bands(100, 50), bands(110, 110)  # the robot's red plate, bumper and blue floor below
+    assert drop_stacked([top, plate]) == [top]
+    beside = bands(160, 50)  # a neighbour at one range, on the same rows
+    assert drop_stacked([top, beside]) == [top, beside]
+    nearer_below = bands(100, 110, spacing=80.0)  # a nearer landmark lower in the image: real
+    assert drop_stacked([top, nearer_below]) == [top, nearer_below]
+    far_away = bands(400, 110)  # same size, lower, but far across the image (a tilted horizon)
+    assert drop_stacked([top, far_away]) == [top, far_away]
