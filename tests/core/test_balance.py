@@ -84,3 +84,5 @@ def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
     assert drop_stacked([top, nearer_below]) == [top, nearer_below]
     far_away = bands(400, 110)  # same size, lower, but far across the image (a tilted horizon)
     assert drop_stacked([top, far_away]) == [top, far_away]
+    smaller_below = bands(104, 100, spacing=16.0)  # a small fragment on the robot's body under it
+    assert drop_stacked([top, smaller_below]) == [top]

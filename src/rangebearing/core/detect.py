@@ -207,25 +207,25 @@ def detect_paper(bgr: np.ndarray, cfg: DetectionParams) -> List[BandCentroids]:
     return [BandCentroids((red[0], red[1]), (blue[0], blue[1]), boxes[0], boxes[1], red[2], blue[2], 0.0, 0.0)]
 
 
-STACK_SIZE = 1.25  # band spacings within this ratio: two landmarks at about one range
+STACK_SIZE = 1.25  # a band spacing up to this much larger is still "its size" (measurement scatter)
 STACK_REACH = 2.0  # ... and within this many widths of each other across the image
 
 
 def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
-    """Drop every landmark that stands wholly below another of about its size nearby in the image.
+    """Drop every landmark that stands wholly below another of its size or larger, nearby in the image.
 
-    Landmarks stand on the floor: two at about one range sit on about one
-    image row, so one whose red band lies below the other's blue band is not a
-    landmark but the robot under the upper one read as one (its red top plate,
-    a pale bumper, a blue floor in front: a red–white–blue column of the
-    right proportions).
+    Landmarks stand on the floor at about the camera's height, so every one
+    spans the horizon's row, a nearer one farther above and below it: one
+    whose red band lies below the other's blue band is not a landmark but the
+    robot under the upper one read as one (its red top plate, a pale bumper, a
+    blue floor in front: a red–white–blue column of the right proportions).
     """
     out = []
     for c in found:
         l_c = c.blue_xy_px[1] - c.red_xy_px[1]
         below = any(
             o is not c
-            and 1 / STACK_SIZE <= l_c / max(o.blue_xy_px[1] - o.red_xy_px[1], 1e-6) <= STACK_SIZE
+            and l_c <= STACK_SIZE * (o.blue_xy_px[1] - o.red_xy_px[1])
             and c.red_xy_px[1] > o.blue_xy_px[1]
             and abs(c.red_xy_px[0] - o.red_xy_px[0]) <= STACK_REACH * max(c.width_px, o.width_px)
             for o in found
