@@ -7,6 +7,12 @@ search, no pairing, just the batched sub-pixel measurement. A track survives
 when both bands are found with about the same weight (area) as before and still
 in the landmark's geometry; otherwise it is lost and the caller scans the whole
 frame next.
+
+Near the frame's edge the moments of what is left lag the landmark (they move
+by about half its motion while it runs out), so there the band's columns are
+measured afresh (:func:`edge_run`): its box then ends at the frame's edge, which
+makes it cut on that side (:func:`.limbs.cut_sides`), and ``visible`` is the
+share of it still in the frame, as a full scan would have it.
 """
 
 from __future__ import annotations
@@ -19,11 +25,13 @@ import numpy as np
 from .._compat import frozen
 from .color import Gains
 from .detect import BandCentroids, combine
+from .edges import excess, limb, linear_table
+from .limbs import FRAME_EDGE_PX, _tile, thin_step
 from .measure import measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
-from .structure import Candidate
+from .structure import MIN_VISIBLE, Candidate
 from .types import XY, BBox, LandmarkGeometry
 
 MASS_RATIO = (0.6, 1.6)  # a band's weight may change this much between frames
@@ -90,7 +98,9 @@ def remeasure(
     """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments."""
     if old.candidate is None:
         return _moved_only(old, red, blue)
-    cand = _moved_candidate(old, red, blue)
+    cand = _moved_candidate(bgr, old, red, blue, gains, geometry)
+    if cand is None:
+        return None
     return combine(bgr, cand, red, blue, gains, geometry, fy_px)  # chroma refs: the ones measure_bands was given
 
 
@@ -101,9 +111,61 @@ def _moved_only(old: BandCentroids, red: BandFix, blue: BandFix) -> BandCentroid
                                red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
 
 
-def _moved_candidate(old: BandCentroids, red: BandFix, blue: BandFix) -> Candidate:
+def _moved_candidate(
+    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry
+) -> Optional[Candidate]:
+    """The old candidate with its boxes moved as the moments moved, re-cut at the frame's edge
+    (:func:`edge_run`); ``None`` when too little of it is left in the frame for a full scan to report it."""
     rb, bb = _moved_bands(old, red, blue)
-    return dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
+    cand = dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
+    mx = motion_margin(rb)[0]
+    if rb[0] - mx > FRAME_EDGE_PX and rb[0] + rb[2] + mx < bgr.shape[1] - FRAME_EDGE_PX:
+        return cand
+    run = edge_run(bgr, cand, red.xy_px[0], gains, geometry)
+    if run is None:
+        return cand
+    x0, x1, visible = run
+    if visible < MIN_VISIBLE:
+        return None
+    return dataclasses.replace(cand, red_bbox_px=(x0, rb[1], x1 - x0, rb[3]), blue_bbox_px=(x0, bb[1], x1 - x0, bb[3]),
+                               visible=visible)
+
+
+def edge_run(
+    bgr: np.ndarray, c: Candidate, core_x_px: float, gains: Gains, geometry: LandmarkGeometry
+) -> Optional[Tuple[int, int, float]]:
+    """``(x0, x1, visible)``: the red band's columns in this frame (end exclusive) and their share of the
+    silhouette, for a landmark that may run off the frame's edge; ``None`` when no side reaches the edge.
+
+    The band's chromaticity profile (as :func:`.limbs.measure_columns` takes it) is
+    followed from ``core_x_px`` (inside the band: its moments) out to each limb
+    (:func:`.edges.limb`); a side that never falls to half the band's level before
+    the frame ends is cut by the edge. A side that falls nowhere short of the
+    frame's edge keeps the candidate's box.
+    """
+    _h, w = bgr.shape[:2]
+    rx, ry, rw, rh = c.red_bbox_px
+    silhouette_px = c.white_px * geometry.diameter_m / (geometry.height_m - 2 * geometry.band_height_m)
+    reach = round(silhouette_px) + motion_margin(c.red_bbox_px)[0]
+    y0, y1 = int(ry + 0.2 * rh), int(ry + 0.8 * rh) + 1
+    tile, ox, _ = _tile(bgr, rx - reach, y0, rx + rw + reach, y1, row_step=thin_step(y1 - y0))
+    n = tile.shape[1]
+    if n < 4 or tile.shape[0] == 0:
+        return None
+    er, _ = excess(tile, gains)
+    q = (er / np.maximum(linear_table()[tile].sum(axis=2), 1e-3)).mean(axis=0)
+    core = max(0, min(n - 1, round(core_x_px) - ox))
+    level = float(np.median(q[max(0, core - 2) : core + 3]))
+    left, right = limb(q, core, 0, level), limb(q, core, n - 1, level)
+    at_left = ox == 0 and not np.isfinite(left)
+    at_right = ox + n == w and not np.isfinite(right)
+    if not (at_left or at_right):
+        return None
+    x0 = 0 if at_left else round(ox + left) if np.isfinite(left) else max(0, rx)
+    x1 = w if at_right else round(ox + right) + 1 if np.isfinite(right) else min(w, rx + rw)
+    if x1 - x0 < 2:
+        return None
+    return x0, x1, min(1.0, (x1 - x0 + 1) / silhouette_px)
 
 
 def step(
@@ -131,7 +193,13 @@ def step(
     found = [(t, red, blue) for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])
              if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
     lost = len(found) < len(tracks)
-    cands = [_moved_candidate(t.bands, red, blue) if t.bands.candidate is not None else None for t, red, blue in found]
+    cands = [_moved_candidate(bgr, t.bands, red, blue, gains, geometry) if t.bands.candidate is not None else None
+             for t, red, blue in found]
+    gone = [k for k, (t, _, _) in enumerate(found) if t.bands.candidate is not None and cands[k] is None]
+    if gone:  # ran off the frame: no reading, as a full scan would give none
+        lost = True
+        found = [f for k, f in enumerate(found) if k not in gone]
+        cands = [c for k, c in enumerate(cands) if k not in gone]
     with_cand = [k for k, c in enumerate(cands) if c is not None]
     rows = measure_rows_all(bgr, [cands[k] for k in with_cand], gains, geometry,
                             [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand])
