@@ -97,3 +97,24 @@ def test_a_lost_landmark_triggers_a_full_scan_on_the_next_frame():
     again = pipe.process(render(jumped))
     assert not again.tracked and len(again.landmarks) == 1
     assert again.landmarks[0].bearing_rad == pytest.approx(-0.25, abs=0.01)
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_a_landmark_running_off_the_frame_edge_is_cut_there_as_a_full_scan_has_it(side):
+    # about 5 px a frame towards the left (side 1) or right edge, until less than half of it is left
+    rng = np.random.default_rng(3)
+    frames = [render(Scene(landmarks=(LandmarkPose(1.0, side * (0.415 + 0.008 * i)),), wall_distance_m=2.5,
+                           imaging=NOISE), rng) for i in range(12)]
+    cfg = load_config(None)
+    full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
+    seen = []
+    for img in frames:
+        a, b = full.process(img), tracker.process(img)
+        assert len(b.landmarks) <= len(a.landmarks)  # a tracked reading only where a full scan has one
+        if b.tracked and a.landmarks and b.landmarks:
+            x, y = a.landmarks[0], b.landmarks[0]
+            assert y.visible == pytest.approx(x.visible, abs=0.06)
+            assert y.bearing_rad == pytest.approx(x.bearing_rad, abs=math.radians(0.1))
+            assert y.range_m == pytest.approx(x.range_m, rel=0.01)
+            seen.append(y.visible)
+    assert len(seen) >= 4 and seen[0] > 0.95 and min(seen) < 0.75  # followed from whole to well cut
