@@ -122,13 +122,19 @@ def _moved_candidate(
     if rb[0] - mx > FRAME_EDGE_PX and rb[0] + rb[2] + mx < bgr.shape[1] - FRAME_EDGE_PX:
         return cand
     run = edge_run(bgr, cand, red.xy_px[0], gains, geometry)
-    if run is None:
-        return cand
+    if run is None:  # near the edge, not at it: the boxes only kept inside the frame
+        w = bgr.shape[1]
+        return dataclasses.replace(cand, red_bbox_px=_clipped(rb, w), blue_bbox_px=_clipped(bb, w))
     x0, x1, visible = run
     if visible < MIN_VISIBLE:
         return None
     return dataclasses.replace(cand, red_bbox_px=(x0, rb[1], x1 - x0, rb[3]), blue_bbox_px=(x0, bb[1], x1 - x0, bb[3]),
                                visible=visible)
+
+
+def _clipped(box: BBox, frame_w_px: int) -> BBox:
+    x0, x1 = max(0, box[0]), min(frame_w_px, box[0] + box[2])
+    return (x0, box[1], max(1, x1 - x0), box[3])
 
 
 def edge_run(
