@@ -28,7 +28,7 @@ from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .structure import Candidate
-from .tracking import Track, step
+from .tracking import Track, crossing, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import reading_sigma
 from .verify import verified
@@ -129,7 +129,8 @@ class Pipeline:
         if det.method == "paper":
             found = detect_paper(bgr, det)
         else:
-            if self.track and self._tracks and self._since_scan < det.full_scan_every - 1:
+            tracking = self.track and self._tracks and self._since_scan < det.full_scan_every - 1
+            if tracking and not crossing(self._tracks):  # crossing landmarks: measured by a full scan
                 self._tracks, lost = step(
                     bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
                 )

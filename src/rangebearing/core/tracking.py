@@ -43,6 +43,20 @@ class Track:
 
     bands: BandCentroids
     velocity_px: XY = (0.0, 0.0)
+    #: the bands' moments (red, blue) measured in the last tracked frame; ``None`` right after a full scan
+    moments_px: Optional[Tuple[XY, XY]] = None
+
+
+def _origin(t: Track) -> BandCentroids:
+    """The bands to move the boxes from: at the moments last measured, so a box moves as its moments move.
+
+    A band's row is the mean of its moment and its edges (:func:`.detect.combine`):
+    moving the box by the moment's step from that mean would add half their
+    difference to the box every frame, and the box would walk off the band.
+    """
+    if t.moments_px is None:
+        return t.bands
+    return dataclasses.replace(t.bands, red_xy_px=t.moments_px[0], blue_xy_px=t.moments_px[1])
 
 
 def _moved(box: BBox, dx: float, dy: float) -> BBox:
@@ -58,6 +72,28 @@ def search_boxes(track: Track) -> Tuple[BBox, BBox]:
     """The red and blue boxes moved by the track's velocity."""
     vx, vy = track.velocity_px
     return _moved(track.bands.red_bbox_px, vx, vy), _moved(track.bands.blue_bbox_px, vx, vy)
+
+
+def crossing(tracks: Sequence[Track], slack_px: float = 2.0) -> bool:
+    """Whether two landmarks may overlap in the image this frame: their predicted columns meet.
+
+    Each landmark's columns are its bands' boxes moved by its velocity and grown
+    by its speed and ``slack_px``. Where two meet, one passes in front of the
+    other: windows then hold parts of both (a track slides onto its neighbour or
+    measures the merged pair), and the one behind is partly hidden in a way
+    that only a full scan measures (or that ends a robot's occlusion). The
+    caller scans the whole frame instead.
+    """
+    if len(tracks) < 2:
+        return False
+    spans = []
+    for t in tracks:
+        red, blue = search_boxes(t)
+        grow = abs(t.velocity_px[0]) + slack_px
+        spans.append((min(red[0], blue[0]) - grow, max(red[0] + red[2], blue[0] + blue[2]) + grow))
+    spans.sort()
+    ends = np.maximum.accumulate([end for _, end in spans])
+    return any(start < end for (start, _), end in zip(spans[1:], ends[:-1]))
 
 
 def plausible(old: BandCentroids, red: BandFix, blue: BandFix, geometry: LandmarkGeometry, lim: PairingLimits) -> bool:
@@ -76,12 +112,12 @@ def plausible(old: BandCentroids, red: BandFix, blue: BandFix, geometry: Landmar
     return abs(blue.xy_px[0] - red.xy_px[0]) <= lim.max_dx * w + lim.slack_px
 
 
-def advance(old: Track, now: BandCentroids) -> Track:
+def advance(old: Track, now: BandCentroids, moments_px: Optional[Tuple[XY, XY]] = None) -> Track:
     """The track after this frame: the new bands, velocity the last step of the centroids."""
     b = old.bands
     rdx, rdy = now.red_xy_px[0] - b.red_xy_px[0], now.red_xy_px[1] - b.red_xy_px[1]
     bdx, bdy = now.blue_xy_px[0] - b.blue_xy_px[0], now.blue_xy_px[1] - b.blue_xy_px[1]
-    return Track(now, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)))
+    return Track(now, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)), moments_px)
 
 
 def _moved_bands(old: BandCentroids, red: BandFix, blue: BandFix) -> Tuple[BBox, BBox]:
@@ -198,8 +234,9 @@ def step(
     fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), margins, cfg, gains, refs=refs)
     found = [(t, red, blue) for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])
              if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
+    found = _tight(bgr, found, cfg, gains, geometry, limits)
     lost = len(found) < len(tracks)
-    cands = [_moved_candidate(bgr, t.bands, red, blue, gains, geometry) if t.bands.candidate is not None else None
+    cands = [_moved_candidate(bgr, _origin(t), red, blue, gains, geometry) if t.bands.candidate is not None else None
              for t, red, blue in found]
     gone = [k for k, (t, _, _) in enumerate(found) if t.bands.candidate is not None and cands[k] is None]
     if gone:  # ran off the frame: no reading, as a full scan would give none
@@ -213,14 +250,37 @@ def step(
     kept: List[Track] = []
     for k, ((t, red, blue), cand) in enumerate(zip(found, cands)):
         if cand is None:
-            now: Optional[BandCentroids] = _moved_only(t.bands, red, blue)
+            now: Optional[BandCentroids] = _moved_only(_origin(t), red, blue)
         else:
             now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, row_of[k])
         if now is None:
             lost = True
             continue
-        kept.append(advance(t, now))
+        kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
     return _distinct(kept), lost
+
+
+def _tight(
+    bgr: np.ndarray, found: List[Tuple[Track, BandFix, BandFix]], cfg: DetectionParams, gains: Gains,
+    geometry: LandmarkGeometry, limits: PairingLimits,
+) -> List[Tuple[Track, BandFix, BandFix]]:
+    """The bands measured again in their moved boxes with a full scan's margins (:func:`.detect.refine`).
+
+    The motion margin lets a window take in what lies around the band (the
+    robot's chassis, a neighbour's edge): its moments lean towards it, the box
+    follows the moments into the next frame, and the lean adds up frame after
+    frame until the next full scan. Measured again in the moved box, grown only
+    as a full scan grows it, a band is read from the same pixels a full scan reads.
+    """
+    if not found:
+        return found
+    m = cfg.downscale + 1
+    boxes = [b for t, red, blue in found for b in _moved_bands(_origin(t), red, blue)]
+    refs = [r for t, _, _ in found for r in (t.bands.red_chroma, t.bands.blue_chroma)]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(found), [(m, m + b[3] // 4) for b in boxes], cfg, gains,
+                          refs=refs)
+    return [(t, red, blue) for (t, _, _), red, blue in zip(found, fixes[0::2], fixes[1::2])
+            if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
 
 
 def _distinct(tracks: List[Track]) -> List[Track]:
