@@ -118,3 +118,23 @@ def test_a_landmark_running_off_the_frame_edge_is_cut_there_as_a_full_scan_has_i
             assert y.range_m == pytest.approx(x.range_m, rel=0.01)
             seen.append(y.visible)
     assert len(seen) >= 4 and seen[0] > 0.95 and min(seen) < 0.75  # followed from whole to well cut
+
+
+def test_landmarks_crossing_in_the_image_are_measured_as_a_full_scan_has_them():
+    # a near landmark passes in front of a far one: windows that meet take in parts of both, and the one
+    # behind is partly hidden as only a full scan measures it
+    rng = np.random.default_rng(1)
+    frames = [render(Scene(landmarks=(LandmarkPose(0.6, -0.08 + 0.006 * i), LandmarkPose(1.2, 0.08 - 0.006 * i)),
+                           wall_distance_m=2.5, imaging=NOISE), rng) for i in range(24)]
+    cfg = load_config(None)
+    full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
+    tracked = 0
+    for img in frames:
+        a, b = full.process(img), tracker.process(img)
+        tracked += b.tracked
+        assert len(b.landmarks) <= len(a.landmarks)  # never a landmark a full scan does not have
+        for y in b.landmarks:
+            x = min(a.landmarks, key=lambda lm: abs(lm.bearing_rad - y.bearing_rad))
+            assert y.range_m == pytest.approx(x.range_m, rel=0.01)
+            assert y.bearing_rad == pytest.approx(x.bearing_rad, abs=math.radians(0.1))
+    assert tracked >= 12  # apart from the crossing itself, still tracked
