@@ -138,3 +138,17 @@ def test_landmarks_crossing_in_the_image_are_measured_as_a_full_scan_has_them():
             assert y.range_m == pytest.approx(x.range_m, rel=0.01)
             assert y.bearing_rad == pytest.approx(x.bearing_rad, abs=math.radians(0.1))
     assert tracked >= 12  # apart from the crossing itself, still tracked
+
+
+def test_a_landmark_coming_out_from_behind_a_nearer_one_is_found_as_it_comes_out():
+    # a near landmark passes in front of a far one standing still: the far one leaves the tracks while hidden
+    rng = np.random.default_rng(4)
+    frames = [render(Scene(landmarks=(LandmarkPose(0.5, -0.16 + 0.012 * i), LandmarkPose(1.3, 0.0)),
+                           wall_distance_m=2.5, imaging=NOISE), rng) for i in range(28)]
+    cfg = load_config(None)
+    full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
+    counts = [(len(full.process(img).landmarks), len(tracker.process(img).landmarks)) for img in frames]
+    hidden = [i for i, (a, _) in enumerate(counts) if a == 1]
+    assert hidden and max(hidden) < len(frames) - 8  # hidden for a while, then out again for a full-scan cycle
+    out = max(hidden) + 1
+    assert all(b == a for a, b in counts[out + 1:])  # found at most a frame after a full scan sees it again

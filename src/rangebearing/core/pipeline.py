@@ -22,6 +22,7 @@ from .balance import balanced_search
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, drop_stacked, find_candidates, refine
+from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .model import in_envelope, reading
 from .pairing import PairingLimits
@@ -87,6 +88,7 @@ class Pipeline:
         to do with the earlier ones (another recording).
         """
         self._tracks: List[Track] = []
+        self._hidden: List[Hidden] = []
         self._since_scan = 0
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
@@ -130,7 +132,8 @@ class Pipeline:
             found = detect_paper(bgr, det)
         else:
             tracking = self.track and self._tracks and self._since_scan < det.full_scan_every - 1
-            if tracking and not crossing(self._tracks):  # crossing landmarks: measured by a full scan
+            # landmarks crossing, or one coming out from behind another: measured by a full scan
+            if tracking and not crossing([*self._tracks, *tracks_of(self._hidden)]):
                 self._tracks, lost = step(
                     bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
                 )
@@ -159,6 +162,8 @@ class Pipeline:
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
+                if self.track:
+                    self._hidden = still_hidden(self._tracks, self._hidden, found, det.full_scan_every)
                 self._tracks = [Track(c) for c in found] if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
