@@ -6,7 +6,7 @@ import pytest
 from rangebearing.core.detect import BandCentroids
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
-from rangebearing.core.verify import rejection
+from rangebearing.core.verify import percentile, rejection
 
 GEOMETRY = LandmarkGeometry()
 RED, WHITE, BLUE = (0.70, 0.07, 0.06), (0.85, 0.85, 0.85), (0.06, 0.12, 0.65)  # linear RGB reflectances
@@ -60,3 +60,14 @@ def test_one_merged_band_is_still_a_landmark_but_two_are_not():
     assert rejection(img, found(red_merged=True), GEOMETRY) is None
     assert rejection(img, found(blue_merged=True), GEOMETRY) is None
     assert "both bands" in rejection(img, found(red_merged=True, blue_merged=True), GEOMETRY)
+
+
+def test_percentile_is_numpys_linear_percentile():
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 3, 7, 24, 100, 577):
+        for dtype in (np.float32, np.float64):
+            v = rng.random((n, 3)).astype(dtype) if n > 1 else np.array([[0.25]], dtype)
+            for pct in (0, 10, 50, 75, 90, 99.5, 100):
+                assert percentile(v, pct) == pytest.approx(float(np.percentile(v, pct)), rel=1e-6, abs=1e-9)
+    ties = np.array([0.2, 0.2, 0.2, 0.9], np.float32)
+    assert percentile(ties, 75) == pytest.approx(float(np.percentile(ties, 75)))
