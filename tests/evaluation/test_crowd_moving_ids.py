@@ -18,10 +18,14 @@ from rangebearing.synth.dataset import generate
 CAMERA = CameraIntrinsics()
 
 
+SEED = 6  # a sequence with robots lost and back within 15 frames, so the return is tested (seed 3,
+#          used before, has no such gap with today's detector and tracker)
+
+
 def test_a_moving_crowd_keeps_its_ids():
     pipe = Pipeline(PipelineParams(camera=CAMERA), track=True)
     frames = [(pipe.process(image, t_s=i / 30.0).landmarks, rows)
-              for i, (_, image, rows) in enumerate(generate(40, 3, "crowd-moving", camera=CAMERA))]
+              for i, (_, image, rows) in enumerate(generate(40, SEED, "crowd-moving", camera=CAMERA))]
     rep = id_report(frames)
     assert rep.robots >= 4 and rep.landmark_frames >= 100, rep
     assert rep.switches_per_1000 <= 1.0, rep
