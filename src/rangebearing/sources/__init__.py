@@ -9,9 +9,9 @@ so the daemon loads only the one it runs (start-up time).
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._compat import lazy_attributes
 from .base import Frame, FrameSource, validate_frame
 
 _LAZY = {
@@ -26,12 +26,7 @@ if TYPE_CHECKING:
     from .recorded import RecordedSource, count_recorded, iter_recorded
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 __all__ = [

@@ -8,8 +8,7 @@ the standard library's ``ThreadingHTTPServer``. See ``docs/view.md``.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+from .._compat import lazy_attributes
 
 # Loaded on first use: the daemon imports view.thresholds on every start, and must not pay for the
 # HTTP server (http.server, email, …) unless daemon.view_port asks for it.
@@ -18,7 +17,4 @@ _LAZY = {"Snapshot": ".hub", "ViewHub": ".hub", "ViewServer": ".server", "Thresh
 __all__ = ["Snapshot", "Thresholds", "ViewHub", "ViewServer"]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name], __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
