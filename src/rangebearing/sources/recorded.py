@@ -12,13 +12,14 @@ import numpy as np
 from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
+from .clip_store import ClipStore
 from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
 from .pacing import Pacer
 from .video_frames import END, EndOfVideo, VideoFrames, open_video
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 PathLike = Union[str, Path]
-_CACHE_BYTES = 64 * 1024 * 1024  # decoded frames kept for looping: ~70 VGA frames
+_CACHE_BYTES = 64 * 1024 * 1024  # decoded frames kept in memory for looping when no ClipStore can take them
 
 
 def list_images(directory: Path) -> List[Path]:
@@ -105,17 +106,20 @@ Fetched = Union[Optional[np.ndarray], EndOfVideo]
 
 
 class _ImageDir:
-    """Random access to a directory's images, with a bounded cache when looping.
+    """Random access to a directory's images, decoded once when looping.
 
-    Cached frames are read-only; ``in_place`` hands them out as they are (a
-    camera's buffers are not copied either), otherwise each is a copy the
-    caller may draw on.
+    Decoded frames go to ``store`` (the page cache, :mod:`.clip_store`), or
+    into a bounded in-memory cache where it cannot take them. Kept frames are
+    read-only; ``in_place`` hands them out as they are (a camera's buffers are
+    not copied either), otherwise each is a copy the caller may draw on.
     """
 
-    def __init__(self, directory: Path, cache: bool, in_place: bool = False) -> None:
+    def __init__(self, directory: Path, cache: bool, in_place: bool = False,
+                 store: Optional[ClipStore] = None) -> None:
         self.paths = list_images(directory)
         self.length: Optional[int] = len(self.paths)
         self._cache: Optional[Dict[int, Optional[np.ndarray]]] = {} if cache else None
+        self._store = store if cache else None
         self._cached_bytes = 0
         self._in_place = in_place
 
@@ -125,17 +129,24 @@ class _ImageDir:
     def get(self, pos: int) -> Fetched:
         if self._cache is None:
             return _decode(self.paths[pos])
-        if pos in self._cache:
+        stored = self._store.get(("bgr", pos)) if self._store is not None else None
+        if stored is not None:
+            image: Optional[np.ndarray] = stored[0]
+        elif pos in self._cache:
             image = self._cache[pos]
         else:
             image = _decode(self.paths[pos])
-            size = 0 if image is None else image.nbytes
-            if self._cached_bytes + size > _CACHE_BYTES:
-                return image  # not kept: the caller's own
-            if image is not None:
-                image.setflags(write=False)
-            self._cache[pos] = image
-            self._cached_bytes += size
+            kept = self._store.put(("bgr", pos), [image]) if self._store is not None and image is not None else None
+            if kept is not None:
+                image = kept[0]
+            else:
+                size = 0 if image is None else image.nbytes
+                if self._cached_bytes + size > _CACHE_BYTES:
+                    return image  # not kept: the caller's own
+                if image is not None:
+                    image.setflags(write=False)
+                self._cache[pos] = image
+                self._cached_bytes += size
         # Else a copy, so a consumer drawing on its frame cannot alter the next loop.
         return image if image is None or self._in_place else image.copy()
 
@@ -158,6 +169,9 @@ class RecordedSource:
     it; kept with the decoded frame when looping, as the ISP makes it for free).
     ``in_place`` (a caller done with each frame before the next, the daemon):
     a looping clip's decoded frames are handed out read-only, uncopied.
+    A looping directory's decoded frames and their YUV420 live in the page
+    cache (:class:`~.clip_store.ClipStore`), mapped into the process only while
+    a frame is in use: the clip does not count in the daemon's memory.
     """
 
     may_block = False  # reads wait only on ``sleep`` (a stop ends them): no reader thread needed
@@ -177,6 +191,7 @@ class RecordedSource:
         self._loop = loop
         self._lores = lores
         self._yuv: Dict[str, Yuv420] = {}  # by frame name, when looping
+        self._store = ClipStore()
         self._clock = clock
         self._pacer = Pacer(float(fps), clock, sleep) if fps else None
         self._reader: Union[_ImageDir, VideoFrames, McapFrames, None] = None
@@ -193,7 +208,8 @@ class RecordedSource:
             return
         p = _check_path(self._path)
         files = McapFrames(p, END) if not p.is_dir() and is_mcap_file(p) else None
-        self._reader = _ImageDir(p, self._loop, self._in_place) if p.is_dir() else files or VideoFrames(p)
+        self._reader = (_ImageDir(p, self._loop, self._in_place, self._store) if p.is_dir()
+                        else files or VideoFrames(p))
         if self._pacer is not None:
             self._pacer.start()
         self._next = 0
@@ -203,12 +219,15 @@ class RecordedSource:
         if self._reader is not None:
             self._reader.close()
             self._reader = None
+        self._yuv.clear()
+        self._store.close()
 
     def read(self) -> Optional[Frame]:
         """The next (paced: newest due) frame; None at the end; FrameError for a corrupt one."""
         reader = self._reader
         if reader is None:
             raise SourceError("recorded source is not open")
+        self._store.release()  # the caller is done with the frame it read last
         i = self._next
         if not self._loop and reader.length is not None and i >= reader.length:
             return None  # the end: no point waiting for a frame that will never come
@@ -241,14 +260,22 @@ class RecordedSource:
 
     def _with_lores(self, frame: Frame) -> Frame:
         yuv = self._yuv.get(frame.name)
-        if yuv is None:
-            frame = with_lores(frame)
-            yuv = frame.lores_yuv420
-            if self._loop and yuv is not None and len(self._yuv) * frame.image.nbytes < _CACHE_BYTES:
-                for plane in (yuv.y, yuv.u, yuv.v):
-                    plane.setflags(write=False)  # handed out again every loop
-                self._yuv[frame.name] = yuv
+        if yuv is not None:
+            self._store.get(("yuv", frame.name))  # mapped in again: released at the next read
+            return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
+        frame = with_lores(frame)
+        yuv = frame.lores_yuv420
+        if not self._loop or yuv is None:
             return frame
+        planes = self._store.put(("yuv", frame.name), [yuv.y, yuv.u, yuv.v])
+        if planes is not None:  # handed out again every loop, read-only
+            yuv = Yuv420(*planes, colour_space=yuv.colour_space)
+        elif len(self._yuv) * frame.image.nbytes < _CACHE_BYTES:
+            for plane in (yuv.y, yuv.u, yuv.v):
+                plane.setflags(write=False)  # handed out again every loop
+        else:
+            return frame
+        self._yuv[frame.name] = yuv
         return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 
     def _fetch(
