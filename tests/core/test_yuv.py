@@ -119,6 +119,43 @@ def test_table_is_cached_and_packs_bounds_and_class():
     assert red >> 16 == RED and (red & 255) <= 82 <= ((red >> 8) & 255)
 
 
+def _table_by_stacking(colour_space, red_hue, blue_hue, s_min, v_min):
+    """class_table as first written (a (256, 256, 3) stack, hue of every U, V pair): the reference."""
+    from rangebearing.core.yuv import COLOUR_SPACES, _rgb_matrix
+
+    a, y0 = COLOUR_SPACES[colour_space][:2]
+    m, _ = _rgb_matrix(colour_space)
+    u, v = np.meshgrid(np.arange(256.0), np.arange(256.0), indexing="ij")
+    d = np.stack([m[k, 1] * (u - 128.0) + m[k, 2] * (v - 128.0) for k in range(3)], axis=-1)
+    bgr = np.ascontiguousarray(d[..., ::-1] + 256.0, dtype=np.float32)
+    hue8 = np.round(cv2.cvtColor(bgr.reshape(-1, 1, 3), cv2.COLOR_BGR2HSV)[:, 0, 0].reshape(256, 256) / 2.0)
+    hue8 = hue8.astype(np.int64) % 180
+    chroma, top = d.max(axis=-1) - d.min(axis=-1), d.max(axis=-1)
+    cls = np.zeros((256, 256), np.uint32)
+    for label, ranges in ((RED, red_hue), (BLUE, blue_hue)):
+        inside = np.zeros((256, 256), bool)
+        for lo, hi in ranges:
+            inside |= (hue8 >= lo) & (hue8 <= hi)
+        cls[inside & (chroma > 0)] = label
+    ylo = np.ceil(y0 + (v_min - 0.5 - top) / a)
+    with np.errstate(divide="ignore"):
+        yhi = np.floor(y0 + (255.0 * chroma / max(s_min - 0.5, 1e-6) - top) / a)
+    empty = (ylo > yhi) | (ylo > 255) | (yhi < 0) | (cls == NONE)
+    ylo = np.where(empty, 255, np.clip(ylo, 0, 255)).astype(np.uint32)
+    yhi = np.where(empty, 0, np.clip(yhi, 0, 255)).astype(np.uint32)
+    return (ylo | (yhi << 8) | (cls << 16)).reshape(-1)
+
+
+@pytest.mark.parametrize("colour_space", ["smpte170m", "rec709"])
+@pytest.mark.parametrize("hues, s_min, v_min", [
+    ((((0, 10), (165, 179)), ((98, 132),)), 90, 25), ((((0, 15),), ((90, 140),)), 40, 10),
+    ((((170, 179),), ((100, 120),)), 1, 0), ((((0, 179),), ((0, 179),)), 255, 255),
+])
+def test_table_is_the_same_as_by_stacking(colour_space, hues, s_min, v_min):
+    got = class_table(colour_space, hues[0], hues[1], s_min, v_min)
+    assert np.array_equal(got, _table_by_stacking(colour_space, hues[0], hues[1], s_min, v_min))
+
+
 def _cast_scene():
     warm = Lighting(colour=(1.25, 1.0, 0.8)) if "colour" in Lighting.__dataclass_fields__ else Lighting()
     return Scene(landmarks=(LandmarkPose(0.5, 0.15), LandmarkPose(1.1, -0.2)), wall_distance_m=1.8, lighting=warm)

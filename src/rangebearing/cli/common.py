@@ -16,11 +16,10 @@ from typing import TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional,
 from ..config import Config, SourceConfig, dump_config, load_config
 from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
-from ..net.zenoh_transport import ZenohSettings
-from .outputs import write_bytes_atomic
 
 if TYPE_CHECKING:
     from ..evaluation.truth import TruthRow
+    from ..net.zenoh_transport import ZenohSettings
 
 T = TypeVar("T")
 DEFAULT_ZENOH_LISTEN = "tcp/127.0.0.1:7447"  # a controller on this machine; tcp/0.0.0.0:7447 for a lab
@@ -76,6 +75,8 @@ def write_atomic(path: Union[str, Path], text: str) -> Optional[Path]:
             shutil.copy2(out, backup)
         except OSError as exc:
             raise OutputError(f"cannot keep {out} as {backup}: {exc.strerror or exc}") from None
+    from .outputs import write_bytes_atomic  # not on `run`'s start-up path
+
     write_bytes_atomic(out, text.encode("utf-8"), durable=True)
     return backup
 
@@ -244,6 +245,8 @@ def settings_from_args(args: argparse.Namespace, default_listen: Optional[str]) 
     """Zenoh settings from the command line; with --connect and no --listen, Zenoh's own default listen."""
     quiet = default_listen and args.mode == "peer" and not args.connect
     listen = tuple(args.listen) or ((default_listen,) if quiet else ())
+    from ..net.zenoh_transport import ZenohSettings  # the Zenoh commands only
+
     return ZenohSettings(mode=args.mode, connect=tuple(args.connect), listen=listen,
                          scouting_multicast=bool(args.scout))
 

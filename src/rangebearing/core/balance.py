@@ -104,7 +104,12 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
     colours = [col for col in (white_body_colour(bgr, c) for c in cands) if col is not None]
     if not colours:
         return None
-    mean = np.maximum(np.median(np.asarray(colours, np.float64), axis=0), 1.0)
+    # np.median's value by a sort: its generic path imports numpy.ma at a process's first float median
+    # (15-19 ms on the daemon's first frame); the colours are finite, so no NaN rule is needed
+    cols = np.sort(np.asarray(colours, np.float64), axis=0)
+    k = len(cols)
+    mid = cols[k // 2] if k % 2 else (cols[k // 2 - 1] + cols[k // 2]) / 2
+    mean = np.maximum(mid, 1.0)
     gains = np.clip(mean.mean() / mean, 1.0 / limit, limit)
     return tuple(float(g) for g in gains)  # type: ignore[return-value]
 

@@ -31,7 +31,6 @@ from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, Ra
 from ..net.fit import encode_fitting
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource, kept
-from ..view.thresholds import Thresholds
 from .capture import CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
 from .recorder import NoRecorder, Recorder
@@ -222,6 +221,8 @@ class Daemon:
             pipe = Pipeline(cfg.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
         except (ValueError, TypeError) as exc:  # validated by the server already; a request never stops the loop
             log.error("thresholds from the view page refused, keeping the running ones: %s", exc)
+            from ..view.thresholds import Thresholds  # with the view page only
+
             self.view.reset_thresholds(Thresholds.of(self.cfg.detection))  # type: ignore[union-attr]
             return
         self.cfg, self._pipe = cfg, pipe
@@ -283,6 +284,8 @@ class Daemon:
             src = new.source
             self.guard.timeout_s, self.guard.budget_s = src.timeout_s, src.timeout_s * src.retries
             if self.view is not None:
+                from ..view.thresholds import Thresholds  # with the view page only
+
                 self.view.reset_thresholds(Thresholds.of(new.detection))
             log.info("config reloaded")
         finally:

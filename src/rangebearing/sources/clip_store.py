@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import mmap
 import os
-import tempfile
 from typing import Dict, Hashable, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -104,6 +103,14 @@ class ClipStore:
 
 def _unlinked_temp_file() -> int:
     """A file descriptor of a new temporary file that has no name (gone with the process, however it ends)."""
+    directory = os.environ.get("TMPDIR") or "/tmp"
+    if hasattr(os, "O_TMPFILE"):  # Linux: born without a name, and no tempfile import (~3 ms) on start-up's path
+        try:
+            return os.open(directory, os.O_TMPFILE | os.O_RDWR, 0o600)
+        except OSError:  # a file system without O_TMPFILE, or no such directory: tempfile finds another
+            pass
+    import tempfile
+
     fd, path = tempfile.mkstemp(prefix="rangebearing-clip-")
     os.unlink(path)
     return fd
