@@ -64,7 +64,7 @@ class DaemonFigures:
     pipeline_cpu_ms: float = float("nan")  # the daemon's own figure: the pipeline's CPU per frame (its final log line)
     tracked_pct: float = float("nan")  # frames the pipeline tracked rather than scanned whole
     bytecode: bool = True  # the package's modules were compiled beforehand, as an installed package's are
-    clip_mib: float = float("nan")  # the recorded clip as the daemon holds it: decoded frames, and their YUV420
+    clip_mib: float = float("nan")  # the recorded clip decoded (frames and their YUV420): in the page cache, not RSS
 
 
 def _command() -> List[str]:
@@ -282,7 +282,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                   f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "
                   f"| {d.cpu_ms_per_frame - d.pipeline_cpu_ms:.3f} "
                   f"| {d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / {d.latency_ms_max:.2f} "
-                  f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} (clip {d.clip_mib:.0f}) | {os.getloadavg()[0]:.2f} |",
+                  f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} (clip {d.clip_mib:.0f} in page cache) | {os.getloadavg()[0]:.2f} |",
                   flush=True)
     return 0
 

@@ -170,11 +170,12 @@ def daemon_table(runs: Sequence[DaemonFigures]) -> str:
     return table(["fps asked", "start-up s (to 1st datagram)", "window s", "datagrams / frames due", "dropped",
                   "seq gaps", "CPU % of a core", "CPU ms per frame", "latency p50 / p99 / max ms",
                   "RSS / peak MiB", "exit", "pipeline CPU ms per frame (tracked)", "rest of the daemon ms per frame",
-                  "recorded clip held MiB"], rows) + (
+                  "recorded clip MiB (page cache, not RSS)"], rows) + (
         "\n\nThe pipeline's CPU is the daemon's own figure (its final log line, all frames of the run); "
         "the rest is the daemon around it (source, encoding, sending, stats). Start-up runs with the "
-        "package's bytecode compiled beforehand, as pip installs it. The RSS includes the recorded clip, "
-        "held decoded (BGR and its YUV420) as a camera's buffers would be; a camera source holds none of it.")
+        "package's bytecode compiled beforehand, as pip installs it. The recorded clip is decoded once "
+        "(BGR and its YUV420, as a camera hands over decoded buffers) into a temporary file's page cache, "
+        "mapped in only while a frame is in use: it is not in the RSS; a camera source holds none of it.")
 
 
 def _valid(run: Run, key: Key, names: Sequence[str]) -> bool:

@@ -22,7 +22,7 @@ import logging
 import signal
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Callable, Dict, Optional
+from typing import TYPE_CHECKING, Callable, Optional
 
 from .. import _signals
 from ..config import Config
@@ -205,11 +205,9 @@ class Daemon:
             if first and self._freeze_gc:
                 gc.freeze()
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
-                self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, self._view_status())
+                status = dataclasses.asdict(self.summary())
+                self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, status)
         return 0
-
-    def _view_status(self) -> Dict[str, Any]:
-        return dataclasses.asdict(self.summary())
 
     def _view_thresholds(self) -> None:
         """Detect with the thresholds a browser set, from this frame on (a new pipeline: tracks restart)."""
@@ -222,7 +220,6 @@ class Daemon:
         except (ValueError, TypeError) as exc:  # validated by the server already; a request never stops the loop
             log.error("thresholds from the view page refused, keeping the running ones: %s", exc)
             from ..view.thresholds import Thresholds  # with the view page only
-
             self.view.reset_thresholds(Thresholds.of(self.cfg.detection))  # type: ignore[union-attr]
             return
         self.cfg, self._pipe = cfg, pipe
@@ -285,7 +282,6 @@ class Daemon:
             self.guard.timeout_s, self.guard.budget_s = src.timeout_s, src.timeout_s * src.retries
             if self.view is not None:
                 from ..view.thresholds import Thresholds  # with the view page only
-
                 self.view.reset_thresholds(Thresholds.of(new.detection))
             log.info("config reloaded")
         finally:

@@ -27,78 +27,98 @@ import numpy as np
 
 CAN_RELEASE = hasattr(mmap.mmap, "madvise") and hasattr(mmap, "MADV_DONTNEED")
 LIMIT_BYTES = 512 * 1024 * 1024  # of temporary file: ~380 VGA frames with their YUV420
+CHUNK_BYTES = 64 * 1024 * 1024  # mapped at a time (address space, on 32-bit Raspberry Pi OS too)
 
 
 class ClipStore:
-    """Arrays written once under a key, read back as read-only views of a file mapping."""
+    """Arrays written once under a key, read back as read-only views of a file mapping.
 
-    def __init__(self, limit_bytes: int = LIMIT_BYTES) -> None:
+    The file is mapped in chunks of :data:`CHUNK_BYTES`; a frame's arrays (its
+    BGR image, then its YUV420 planes) are written one after the other, so the
+    pages a read used are one span and :meth:`release` is one ``madvise`` call.
+    """
+
+    def __init__(self, limit_bytes: int = LIMIT_BYTES, chunk_bytes: int = CHUNK_BYTES) -> None:
         self.limit_bytes = limit_bytes
+        self.chunk_bytes = chunk_bytes
         self.failed = not CAN_RELEASE
         self._file: Optional[int] = None
-        self._end = 0
-        self._entries: Dict[Hashable, Tuple[mmap.mmap, List[np.ndarray]]] = {}
-        self._mapped: Dict[Hashable, mmap.mmap] = {}  # handed out since the last release
+        self._chunks: List[mmap.mmap] = []
+        self._used = 0  # bytes of the last chunk taken
+        self._entries: Dict[Hashable, Tuple[int, int, int, List[np.ndarray]]] = {}  # chunk, start, end, views
+        self._spans: Dict[int, Tuple[int, int]] = {}  # chunk -> pages handed out since the last release
 
     @property
     def nbytes(self) -> int:
-        """Bytes written to the file so far."""
-        return self._end
+        """Bytes of the file taken so far (whole chunks but the last)."""
+        return max(0, len(self._chunks) - 1) * self.chunk_bytes + self._used
 
     def get(self, key: Hashable) -> Optional[List[np.ndarray]]:
         """The arrays stored under ``key`` (the same objects every time), or None."""
         entry = self._entries.get(key)
         if entry is None:
             return None
-        self._mapped[key] = entry[0]
-        return entry[1]
+        self._handed_out(*entry[:3])
+        return entry[3]
 
     def put(self, key: Hashable, arrays: Sequence[np.ndarray]) -> Optional[List[np.ndarray]]:
         """Store ``arrays`` (C-contiguous or not) under ``key``; their read-only views, or None if not kept."""
         if self.failed:
             return None
-        sizes = [a.nbytes for a in arrays]
-        spans, offset = [], 0
-        for n in sizes:  # each array page-aligned within the entry
-            spans.append(offset)
-            offset += -(-n // mmap.PAGESIZE) * mmap.PAGESIZE
-        if offset == 0 or self._end + offset > self.limit_bytes:
+        spans, size = [], 0
+        for a in arrays:  # each array page-aligned within the entry
+            spans.append(size)
+            size += -(-a.nbytes // mmap.PAGESIZE) * mmap.PAGESIZE
+        if size == 0 or size > self.chunk_bytes:
+            return None
+        new_chunk = not self._chunks or self._used + size > self.chunk_bytes
+        if new_chunk and (len(self._chunks) + 1) * self.chunk_bytes > self.limit_bytes:
             return None
         try:
             if self._file is None:
                 self._file = _unlinked_temp_file()
+            if new_chunk:
+                base = len(self._chunks) * self.chunk_bytes
+                os.ftruncate(self._file, base + self.chunk_bytes)  # sparse: the disk holds what is written
+                self._chunks.append(mmap.mmap(self._file, self.chunk_bytes, access=mmap.ACCESS_READ, offset=base))
+                self._used = 0
+            at = (len(self._chunks) - 1) * self.chunk_bytes + self._used
             for a, start in zip(arrays, spans):
                 data = memoryview(np.ascontiguousarray(a)).cast("B")
-                written = 0
-                while written < len(data):
-                    written += os.pwrite(self._file, data[written:], self._end + start + written)
-            os.ftruncate(self._file, self._end + offset)  # the last array's page padding
-            mapping = mmap.mmap(self._file, offset, access=mmap.ACCESS_READ, offset=self._end)
+                done = 0
+                while done < len(data):
+                    done += os.pwrite(self._file, data[done:], at + start + done)
         except (OSError, ValueError):  # a full or read-only temp dir, a failed mapping: keep frames in memory
             self.failed = True
             return None
-        self._end += offset
-        views = [np.frombuffer(mapping, a.dtype, a.size, start).reshape(a.shape)
+        chunk, mapping, first = len(self._chunks) - 1, self._chunks[-1], self._used
+        views = [np.frombuffer(mapping, a.dtype, a.size, first + start).reshape(a.shape)
                  for a, start in zip(arrays, spans)]  # read-only: the mapping is
-        self._entries[key] = (mapping, views)
-        self._mapped[key] = mapping
+        self._used += size
+        self._entries[key] = (chunk, first, first + size, views)
+        self._handed_out(chunk, first, first + size)
         return views
 
+    def _handed_out(self, chunk: int, start: int, end: int) -> None:
+        lo, hi = self._spans.get(chunk, (start, end))
+        self._spans[chunk] = (min(lo, start), max(hi, end))
+
     def release(self) -> None:
-        """Drop the pages of every entry handed out since the last call from this process's memory."""
-        for mapping in self._mapped.values():
-            with contextlib.suppress(OSError, ValueError):  # closed, or refused: the pages just stay mapped
-                mapping.madvise(mmap.MADV_DONTNEED)
-        self._mapped.clear()
+        """Drop the pages handed out since the last call from this process's memory (one span a chunk)."""
+        for chunk, (lo, hi) in self._spans.items():
+            with contextlib.suppress(OSError, ValueError):  # refused: the pages just stay mapped
+                self._chunks[chunk].madvise(mmap.MADV_DONTNEED, lo, hi - lo)
+        self._spans.clear()
 
     def close(self) -> None:
         """Forget the entries; views still held elsewhere keep their mapping alive until they go."""
         self._entries.clear()
-        self._mapped.clear()
+        self._spans.clear()
+        self._chunks = []
+        self._used = 0
         if self._file is not None:
             os.close(self._file)
             self._file = None
-        self._end = 0
 
 
 def _unlinked_temp_file() -> int:
