@@ -23,6 +23,7 @@ from typing import Callable, List, Optional, Sequence, Tuple
 import numpy as np
 
 from .color import CLIPPED, DARK, UNIT_GAINS, Gains
+from .stats import median_rows
 from .structure import Candidate
 
 NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
@@ -79,7 +80,7 @@ def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
     px = px[(top_ch >= DARK) & (top_ch < CLIPPED)]
     if len(px) < MIN_WHITE_PX:
         return None
-    return np.median(px, axis=0)
+    return median_rows(px)
 
 
 def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float = 2.0) -> Optional[Gains]:
@@ -104,12 +105,8 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
     colours = [col for col in (white_body_colour(bgr, c) for c in cands) if col is not None]
     if not colours:
         return None
-    # np.median's value by a sort: its generic path imports numpy.ma at a process's first float median
-    # (15-19 ms on the daemon's first frame); the colours are finite, so no NaN rule is needed
-    cols = np.sort(np.asarray(colours, np.float64), axis=0)
-    k = len(cols)
-    mid = cols[k // 2] if k % 2 else (cols[k // 2 - 1] + cols[k // 2]) / 2
-    mean = np.maximum(mid, 1.0)
+    # np.median's value by a partial sort (core/stats.py): np.median imports numpy.ma at a process's first call
+    mean = np.maximum(median_rows(np.asarray(colours, np.float64)), 1.0)
     gains = np.clip(mean.mean() / mean, 1.0 / limit, limit)
     return tuple(float(g) for g in gains)  # type: ignore[return-value]
 

@@ -25,6 +25,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import Gains
+from .stats import median
 
 GAMMA = 2.2
 BG_ROWS = 4  # rows averaged for a background level
@@ -176,7 +177,7 @@ def limb(profile: np.ndarray, core: int, end: int, level: float) -> float:
     k = int(fall[0])
     stop = min(len(seg) - 1, k + LIMB_BLUR_PX)
     start = max(0, k - LIMB_BLUR_PX - 1)
-    bg = float(np.median(seg[k + 1 : k + 1 + BG_ROWS])) if k + 1 < len(seg) else float(seg[k])
+    bg = median(seg[k + 1 : k + 1 + BG_ROWS]) if k + 1 < len(seg) else float(seg[k])
     if not level - bg > MERGE_CONTRAST * abs(level):
         return float("nan")
     edge = edge_down(seg, start, stop, level, bg)  # columns counted outwards from ``core``

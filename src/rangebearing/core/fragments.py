@@ -26,6 +26,8 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
+from .stats import median
+
 STEP_PX = 1.5  # an edge or white height that differs by this much between two pieces is another landmark
 MIN_PIECE = 2  # columns of the narrowest piece a run is split into
 MIN_SHARE = 0.15  # share of a silhouette each fragment joined across a gap must show
@@ -175,4 +177,4 @@ def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], br
     v = hsv[top : max(top, brows[1]), c0:c1][..., 2]
     body = v[rrows[1] - top : brows[0] - top]
     bands = np.concatenate((v[: rrows[1] - top].ravel(), v[brows[0] - top :].ravel()))
-    return body.size == 0 or bands.size == 0 or float(np.median(body)) >= BODY_V_SHARE * float(np.median(bands))
+    return body.size == 0 or bands.size == 0 or median(body) >= BODY_V_SHARE * median(bands)

@@ -18,6 +18,7 @@ import numpy as np
 from .color import Gains
 from .edges import excess, limb, linear_table
 from .refine import Pyramid
+from .stats import median
 from .structure import Candidate
 from .types import LandmarkGeometry
 
@@ -101,7 +102,7 @@ def measure_columns(
             core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
         else:
             core = max(0, min(n - 1, int(rx - ox) + int(half)))
-        level = float(np.median(q[max(0, core - 2) : core + 3]))
+        level = median(q[max(0, core - 2) : core + 3])
         edges.append(ox + limb(q, core, n - 1 if cut_left else 0, level))
     edges = [e for e in edges if math.isfinite(e)]
     if not edges:

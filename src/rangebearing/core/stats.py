@@ -1,0 +1,50 @@
+"""Order statistics of small arrays by a partial sort: ``np.median``'s values without its generic path.
+
+``np.median`` goes through ``_ureduce``, a full ``np.mean`` of the middle pair and
+a NaN check: tens of microseconds a call, and the pipeline takes medians of tiny
+arrays per band and per landmark. Its first call in a process also imports
+``numpy.ma`` (15–20 ms, on the daemon's start-up path). These give the same values:
+the middle order statistic, or the mean of the middle two (their sum halved in the
+input's float type, or in float64 for integers, as ``np.mean`` computes it), NaN when a float input holds a NaN.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def median(values: np.ndarray) -> float:
+    """``float(np.median(values))`` of any non-empty array (flattened), by a partial sort."""
+    a = np.asarray(values).ravel()
+    n = a.size
+    half = n // 2
+    nan_check = a.dtype.kind in "fc"
+    if n % 2:
+        part = np.partition(a, (half, n - 1) if nan_check else half)
+        mid = float(part[half])
+    else:
+        part = np.partition(a, (half - 1, half, n - 1) if nan_check else (half - 1, half))
+        # np.mean's arithmetic: in the float type itself, in float64 for integers
+        lo, hi = part[half - 1], part[half]
+        mid = float((lo + hi) / 2) if nan_check else (float(lo) + float(hi)) / 2.0
+    if nan_check and part[n - 1] != part[n - 1]:  # np.partition puts NaNs last
+        return float("nan")
+    return mid
+
+
+def median_rows(values: np.ndarray) -> np.ndarray:
+    """``np.median(values, axis=0)`` of a non-empty 2-D array of integers (float64 out) or floats (their type)."""
+    a = np.asarray(values)
+    n = a.shape[0]
+    half = n // 2
+    nan_check = a.dtype.kind in "fc"
+    if n % 2:
+        part = np.partition(a, (half, n - 1) if nan_check else half, axis=0)
+        out = part[half].astype(a.dtype if nan_check else np.float64)
+    else:
+        part = np.partition(a, (half - 1, half, n - 1) if nan_check else (half - 1, half), axis=0)
+        lo, hi = part[half - 1], part[half]
+        out = (lo + hi) / 2 if nan_check else (lo.astype(np.float64) + hi.astype(np.float64)) / 2
+    if nan_check:
+        out[np.isnan(part[n - 1])] = np.nan
+    return out
