@@ -52,17 +52,24 @@ def excess(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray]:
 
 def _mean(x: np.ndarray) -> float:
     """``float(x.mean())`` of a float32 array, bit for bit, without ``np.mean``'s overhead (it runs per band)."""
-    return float(np.float32(float(x.sum()) / x.size))
+    return float(np.float32(float(np.add.reduce(x)) / x.size))
+
+
+def mean_along(a: np.ndarray, axis: int) -> np.ndarray:
+    """``a.mean(axis=axis)`` of a 2-D float32 array, bit for bit (the same sum, divided by the same
+    count in the same way), without ``np.mean``'s Python layer (it runs several times per band)."""
+    s = np.add.reduce(a, axis=axis)
+    return np.true_divide(s, np.intp(a.shape[axis]), out=s, casting="unsafe")
 
 
 def edge_down(p: np.ndarray, a: int, b: int, level: float, bg: float) -> float:
     """Edge between row ``a`` (inside, level ``level``) and row ``b`` > a (outside, ``bg``) of profile ``p``."""
-    return (a - 0.5) + float((p[a : b + 1] - bg).sum()) / (level - bg)
+    return (a - 0.5) + float(np.add.reduce(p[a : b + 1] - bg)) / (level - bg)
 
 
 def edge_up(p: np.ndarray, a: int, b: int, level: float, bg: float) -> float:
     """Edge between row ``a`` (inside) and row ``b`` < a (outside) of profile ``p``, going up."""
-    return (a + 0.5) - float((p[b : a + 1] - bg).sum()) / (level - bg)
+    return (a + 0.5) - float(np.add.reduce(p[b : a + 1] - bg)) / (level - bg)
 
 
 @frozen
@@ -86,7 +93,7 @@ def band_rows(
     last background row beyond the outer edge (clipped to the array). ``p`` is ``p2d.mean(axis=1)``
     when the caller has it already.
     """
-    p = p2d.mean(axis=1) if p is None else p
+    p = mean_along(p2d, 1) if p is None else p
     n = len(p)
     top, bottom = max(0, top), min(n - 1, bottom)
     core_lo, core_hi = top + (bottom - top) // 4, bottom - (bottom - top) // 4
@@ -138,20 +145,23 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
     """
     lo, hi = (mid, end) if down else (end, mid)
     beyond = p2d[end : end + BG_ROWS] if down else p2d[max(0, end - BG_ROWS + 1) : end + 1]
-    lev = p2d[max(0, mid - 1) : mid + 2].mean(axis=0)
-    bgc = beyond.mean(axis=0) if beyond.size else np.full(p2d.shape[1], bg, np.float32)
+    lev = mean_along(p2d[max(0, mid - 1) : mid + 2], 0)
+    bgc = mean_along(beyond, 0) if beyond.size else np.full(p2d.shape[1], bg, np.float32)
     step = lev - bgc
     ok = step > 0.5 * (level - bg)
-    cols = int(ok.sum())
+    idx = np.flatnonzero(ok)
+    cols = len(idx)
     if cols < 5:
         return 0.5
-    sums = (p2d[lo : hi + 1, ok] - bgc[ok]).sum(axis=0) / step[ok]
-    x = np.flatnonzero(ok).astype(np.float64)
-    x -= x.mean()
+    sums = np.add.reduce(p2d[lo : hi + 1, ok] - bgc[ok], axis=0) / step[ok]
+    x = idx.astype(np.float64)
+    x -= np.add.reduce(x) / cols
     x2 = x * x
-    x2 -= x2.mean()
-    a = np.stack([x, x2 - x * (x @ x2) / (x @ x)])  # orthogonal to each other and to the constant
-    res = sums - sums.mean() - (a @ sums / np.einsum("ij,ij->i", a, a)) @ a
+    x2 -= np.add.reduce(x2) / cols
+    a = np.empty((2, cols))
+    a[0] = x
+    a[1] = x2 - x * (x @ x2) / (x @ x)  # orthogonal to each other and to the constant
+    res = sums - np.float32(np.add.reduce(sums) / np.intp(cols)) - (a @ sums / np.einsum("ij,ij->i", a, a)) @ a
     return float(np.sqrt((res @ res) / (cols - 3)) / np.sqrt(cols))
 
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import Gains
-from .edges import BandEdges, band_rows, excess
+from .edges import BandEdges, band_rows, excess, mean_along
 from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_centre, thin_step
 from .structure import Candidate
 from .types import LandmarkGeometry
@@ -143,8 +143,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     hb, hw = band_px / f, c.white_px / f
     r_exp = (ry + 0.5 * rh - oy) / f - 0.5
     b_exp = (by + 0.5 * bh - oy) / f - 0.5
-    red = _band(er, er.mean(axis=1), r_exp, hb, hw, True)
-    blue = _band(eb, eb.mean(axis=1), b_exp, hb, hw, False)
+    red = _band(er, mean_along(er, 1), r_exp, hb, hw, True)
+    blue = _band(eb, mean_along(eb, 1), b_exp, hb, hw, False)
     if red is None or blue is None or not blue.inner > red.inner:
         return None
     white = blue.inner - red.inner
