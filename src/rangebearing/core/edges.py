@@ -154,15 +154,30 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
     if cols < 5:
         return 0.5
     sums = np.add.reduce(p2d[lo : hi + 1, ok] - bgc[ok], axis=0) / step[ok]
-    x = idx.astype(np.float64)
-    x -= np.add.reduce(x) / cols
+    a, aa = _curve_basis(idx.tobytes())
+    res = sums - np.float32(np.add.reduce(sums) / np.intp(cols)) - (a @ sums / aa) @ a
+    return float(np.sqrt((res @ res) / (cols - 3)) / np.sqrt(cols))
+
+
+@functools.lru_cache(maxsize=512)
+def _curve_basis(columns: bytes) -> Tuple[np.ndarray, np.ndarray]:
+    """``(a, a·a)`` of :func:`_column_sigma` for the columns (``np.intp`` indices, as bytes): the centred column
+    and the parabola orthogonal to it and to the constant, and their squared norms.
+
+    They depend on which columns took part only, and nearly every band of a landmark seen whole
+    has all of its columns: one computation serves them all (the same arithmetic, so the same values).
+    """
+    x = np.frombuffer(columns, np.intp).astype(np.float64)
+    x -= np.add.reduce(x) / len(x)
     x2 = x * x
-    x2 -= np.add.reduce(x2) / cols
-    a = np.empty((2, cols))
+    x2 -= np.add.reduce(x2) / len(x)
+    a = np.empty((2, len(x)))
     a[0] = x
     a[1] = x2 - x * (x @ x2) / (x @ x)  # orthogonal to each other and to the constant
-    res = sums - np.float32(np.add.reduce(sums) / np.intp(cols)) - (a @ sums / np.einsum("ij,ij->i", a, a)) @ a
-    return float(np.sqrt((res @ res) / (cols - 3)) / np.sqrt(cols))
+    a.flags.writeable = False
+    aa = np.einsum("ij,ij->i", a, a)
+    aa.flags.writeable = False
+    return a, aa
 
 
 LIMB_BLUR_PX = 3  # columns a limb's edge may be spread over (optics, sensor, the ½-resolution search)

@@ -14,6 +14,7 @@ placed from its other limb.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import List, Optional, Sequence, Tuple
 
@@ -188,6 +189,14 @@ def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     return dataclasses.replace(blue, merged=True)
 
 
+@functools.lru_cache(maxsize=64)
+def _box(k: int) -> np.ndarray:
+    """The ``k``-row box kernel of :func:`_band` (float32, read-only)."""
+    box = np.full(k, 1.0 / k, np.float32)
+    box.flags.writeable = False
+    return box
+
+
 def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool):
     """:func:`.edges.band_rows` around the row of strongest colour near ``expected`` (``p``: the row profile)."""
     n = p2d.shape[0]
@@ -198,7 +207,7 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
     # seed on the band-sized run of strongest colour, not the strongest row: a bright background
     # beyond the outer edge leaves a one-row demosaic fringe that can beat the band's own level
     k = max(1, int(0.5 * hb + 0.5))
-    smooth = np.convolve(prof, np.full(k, 1.0 / k, np.float32), mode="same") if k > 1 else prof
+    smooth = np.convolve(prof, _box(k), mode="same") if k > 1 else prof
     top = int(np.argmax(smooth))
     strong = prof >= 0.5 * smooth[top]
     first, last = top, top  # the band's rows: the run of strong colour around the strongest row
