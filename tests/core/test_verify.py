@@ -71,3 +71,14 @@ def test_percentile_is_numpys_linear_percentile():
                 assert percentile(v, pct) == pytest.approx(float(np.percentile(v, pct)), rel=1e-6, abs=1e-9)
     ties = np.array([0.2, 0.2, 0.2, 0.9], np.float32)
     assert percentile(ties, 75) == pytest.approx(float(np.percentile(ties, 75)))
+
+
+def test_percentile_through_a_table_is_the_percentile_of_the_looked_up_values():
+    from rangebearing.core.edges import linear_table
+
+    rng = np.random.default_rng(4)
+    table = linear_table()
+    for n in (1, 2, 5, 24, 576):
+        v = rng.integers(0, 256, (n,)).astype(np.uint8)
+        for pct in (0, 50, 75, 90, 100):
+            assert percentile(v, pct, table) == percentile(table[v], pct)  # the same value, bit for bit

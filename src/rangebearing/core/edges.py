@@ -18,6 +18,7 @@ map linearly to rows. The sRGB-like encoding is undone with a 2.2 power.
 from __future__ import annotations
 
 import functools
+import math
 from typing import Optional, Tuple
 
 import cv2
@@ -156,7 +157,7 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
     sums = np.add.reduce(p2d[lo : hi + 1, ok] - bgc[ok], axis=0) / step[ok]
     a, aa = _curve_basis(idx.tobytes())
     res = sums - np.float32(np.add.reduce(sums) / np.intp(cols)) - (a @ sums / aa) @ a
-    return float(np.sqrt((res @ res) / (cols - 3)) / np.sqrt(cols))
+    return math.sqrt(float(res @ res) / (cols - 3)) / math.sqrt(cols)  # IEEE square roots, as numpy's
 
 
 @functools.lru_cache(maxsize=512)

@@ -97,20 +97,27 @@ def measure_rows_all(
     """
     wins = [_row_window(bgr.shape, c, geometry, x) for c, x in zip(cands, xs_px)]
     tiles, weights = [], []
-    for k, win in enumerate(wins):
-        if win is None:
-            continue
-        x0, y0, x1, y1, step, a, b = win
-        tile = bgr[y0:y1, x0:x1:step]
+    live = [k for k, win in enumerate(wins) if win is not None]
+    if live:
         # end columns count by the share of them inside [a, b]: the profile moves smoothly with x
-        cols = x0 + step * np.arange(tile.shape[1])
-        wgt = np.clip(np.minimum(cols + 0.5, b) - np.maximum(cols - 0.5, a), 0.0, 1.0).astype(np.float32)
-        if wgt.sum() <= 0:
-            wins[k] = None
-            continue
-        wgt *= len(wgt) / wgt.sum()
-        tiles.append(tile)
-        weights.append(wgt)
+        # (every window's column weights in one go: the same element-wise arithmetic as one at a time)
+        x0s, steps, lo, hi = (np.array([wins[k][i] for k in live]) for i in (0, 4, 5, 6))
+        widths = np.array([-(-(wins[k][2] - wins[k][0]) // wins[k][4]) for k in live])
+        first = np.cumsum(widths) - widths
+        local = np.arange(int(widths.sum())) - np.repeat(first, widths)  # each window's column number
+        cols = np.repeat(x0s, widths) + np.repeat(steps, widths) * local
+        wgt_all = np.clip(np.minimum(cols + 0.5, np.repeat(hi, widths)) - np.maximum(cols - 0.5, np.repeat(lo, widths)),
+                          0.0, 1.0).astype(np.float32)
+        for k, f, n in zip(live, first.tolist(), widths.tolist()):
+            wgt = wgt_all[f : f + n]
+            total = np.add.reduce(wgt)
+            if total <= 0:
+                wins[k] = None
+                continue
+            wgt *= n / total
+            x0, y0, x1, y1, step = wins[k][:5]
+            tiles.append(bgr[y0:y1, x0:x1:step])
+            weights.append(wgt)
     if not tiles:
         return [None] * len(cands)
     offs = np.cumsum([0] + [t.shape[0] for t in tiles]).tolist()
