@@ -75,9 +75,10 @@ def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
     if y1 <= y0 or x1 <= x0:
         return None
     sy, sx = max(1, (y1 - y0) // SAMPLES), max(1, (x1 - x0) // SAMPLES)
-    px = bgr[y0:y1:sy, x0:x1:sx].reshape(-1, 3)
-    top_ch = px.max(axis=1)
-    px = px[(top_ch >= DARK) & (top_ch < CLIPPED)]
+    sub = bgr[y0:y1:sy, x0:x1:sx]
+    # the channels' maximum pairwise: numpy's reduction over a length-3 axis is ~10x slower
+    top_ch = np.maximum(np.maximum(sub[..., 0], sub[..., 1]), sub[..., 2])
+    px = np.compress(((top_ch >= DARK) & (top_ch < CLIPPED)).ravel(), sub.reshape(-1, 3), axis=0)  # = sub[mask]
     if len(px) < MIN_WHITE_PX:
         return None
     return median_rows(px)

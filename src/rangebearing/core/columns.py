@@ -17,6 +17,11 @@ BRIDGE = 2  # columns of a gap bridged between agreeing edges
 WHITE_S_MAX, WHITE_V_MIN = 80, 40  # the white body: low saturation, not dark
 
 
+def _nonzero(a: np.ndarray) -> np.ndarray:
+    """``np.flatnonzero(a)`` without its two Python wrappers (it runs a dozen times per window stack)."""
+    return a.ravel().nonzero()[0]
+
+
 def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[np.ndarray, ...]:
     """Per column of a window: ``(ok, y1, y2, run_r, run_b)``.
 
@@ -42,33 +47,33 @@ def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     edge = red.copy()
     edge[:, :-1] &= ~red[:, 1:]
     edge[:, -1] = False
-    red_bottoms = np.flatnonzero(edge)
+    red_bottoms = _nonzero(edge)
     edge = red.copy()
     edge[:, 1:] &= ~red[:, :-1]
-    red_tops = np.flatnonzero(edge)
+    red_tops = _nonzero(edge)
     edge = blue.copy()
     edge[:, 1:] &= ~blue[:, :-1]
     edge[:, 0] = False
-    tops = np.flatnonzero(edge)
+    tops = _nonzero(edge)
     edge = blue.copy()
     edge[:, :-1] &= ~blue[:, 1:]
-    blue_bottoms = np.flatnonzero(edge)
+    blue_bottoms = _nonzero(edge)
     col = tops // h
     # the last red bottom above each blue top, in its column (else none: -1)
-    k = np.searchsorted(red_bottoms, tops) - 1
+    k = red_bottoms.searchsorted(tops) - 1
     above = red_bottoms[np.maximum(k, 0)] if len(red_bottoms) else np.zeros(len(tops), np.int64)
     has = (k >= 0) & (above >= base[col])
     row = tops - base[col]
     y1 = np.where(has, above - base[col], -1)
     gap = row - y1 - 1
-    cum_w = np.cumsum(white.reshape(-1), dtype=np.int32)
+    cum_w = white.reshape(-1).cumsum(dtype=np.int32)
     whites = cum_w[tops - 1] - cum_w[np.where(has, above, 0)]  # white rows strictly between y1 and the top
     valid = has & (gap >= 2) & (whites >= WHITE_SHARE * gap)
     share = whites / np.maximum(gap, 1) - 1e-3 * gap
     ok = np.zeros(w, bool)
     y2 = np.zeros(w, np.int64)
     b1 = np.full(w, -1, np.int64)
-    v = np.flatnonzero(valid)
+    v = _nonzero(valid)
     if len(v):
         v = v[np.lexsort((row[v], -share[v], col[v]))]  # per column: whitest, then the shortest
         cv = col[v]
@@ -79,16 +84,16 @@ def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     # red run ending at y1 (start: the last red top at or above it); without a pair, as at y1 = -1 → row 0
     run_r = np.where(red[:, 0], 0, -1)
     if ok.any():
-        c = np.flatnonzero(ok)
+        c = _nonzero(ok)
         q = base[c] + b1[c]
-        run_r[c] = q - red_tops[np.searchsorted(red_tops, q, side="right") - 1] + 1
+        run_r[c] = q - red_tops[red_tops.searchsorted(q, side="right") - 1] + 1
     # blue run starting at y2 (end: the first blue bottom at or below it); without a pair, from row 0
     start = base + y2
     run_b = np.zeros(w, np.int64)
     in_blue = blue[np.arange(w), y2]
     if in_blue.any():
-        c = np.flatnonzero(in_blue)
-        run_b[c] = blue_bottoms[np.searchsorted(blue_bottoms, start[c])] - start[c] + 1
+        c = _nonzero(in_blue)
+        run_b[c] = blue_bottoms[blue_bottoms.searchsorted(start[c])] - start[c] + 1
     return ok, b1, y2, run_r, run_b
 
 
@@ -106,10 +111,10 @@ def bridge(
     seg = np.zeros(n, np.int64)
     if len(starts):
         seg[np.asarray(starts, np.int64)] = 1
-        seg = np.cumsum(seg)
-    idx = np.flatnonzero(ok)
-    d = np.diff(idx)
-    gaps = np.flatnonzero((d > 1) & (d <= BRIDGE + 1) & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
+        seg = seg.cumsum()
+    idx = _nonzero(ok)
+    d = idx[1:] - idx[:-1]
+    gaps = _nonzero((d > 1) & (d <= BRIDGE + 1) & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
     for g in gaps.tolist():
         a, b = idx[g], idx[g + 1]
         if abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
@@ -128,7 +133,7 @@ def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] =
     the window ``starts`` of :func:`bridge`)."""
     step = EDGE_STEP + 0.05 * (y2 - y1)
     jump = np.zeros(len(ok), bool)
-    jump[1:] = (np.abs(np.diff(y1)) > step[1:]) | (np.abs(np.diff(y2)) > step[1:])
+    jump[1:] = (np.abs(y1[1:] - y1[:-1]) > step[1:]) | (np.abs(y2[1:] - y2[:-1]) > step[1:])  # np.diff's values
     prev_ok = np.concatenate(([False], ok[:-1]))
     next_ok = np.concatenate((ok[1:], [False]))
     if len(starts):
@@ -136,8 +141,8 @@ def runs(ok: np.ndarray, y1: np.ndarray, y2: np.ndarray, starts: Sequence[int] =
         prev_ok[b] = False
         next_ok[b - 1] = False
     next_jump = np.concatenate((jump[1:], [True]))
-    first = np.flatnonzero(ok & (~prev_ok | jump))
-    stops = np.flatnonzero(ok & (~next_ok | next_jump)) + 1
+    first = _nonzero(ok & (~prev_ok | jump))
+    stops = _nonzero(ok & (~next_ok | next_jump)) + 1
     return list(zip(first.tolist(), stops.tolist()))
 
 
@@ -195,7 +200,7 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
         s0 = np.array([f[0] for f in found], np.int64)
         s1 = np.array([f[1] for f in found], np.int64)
         med = _run_medians(np.stack((e2 - e1 - 1, run_r, run_b, e1, e2)), s0, s1)
-        owner = np.searchsorted(offs, s0, side="right") - 1
+        owner = offs.searchsorted(s0, side="right") - 1
         for q, (a, z, w_k) in enumerate(zip(s0.tolist(), s1.tolist(), owner.tolist())):
             o = int(offs[w_k])
             out[batch[w_k]].append((a - o, z - o, *(float(v) for v in med[:, q])))
