@@ -57,18 +57,20 @@ def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
     tiny = cv2.resize(bgr, (max(1, w // f), max(1, h // f)), interpolation=cv2.INTER_AREA) if f > 1 else bgr
     pixels = tiny.reshape(-1, 3).astype(np.float32)
     gains = np.ones(3, np.float64)
+    # (numpy's values throughout, without the Python layers of np.clip, .mean() and .sum() on 3 numbers)
     for _ in range(BALANCE_ITERATIONS):
-        q = apply_gains(tiny, tuple(gains)) if (gains != 1.0).any() else tiny
+        g = gains.tolist()
+        q = apply_gains(tiny, tuple(g)) if g != [1.0, 1.0, 1.0] else tiny
         _, s, v = cv2.split(cv2.cvtColor(q, cv2.COLOR_BGR2HSV))
         # weight: neutral-ness from S (after the gains), zero for dark or clipped V (one table each)
         wgt = cv2.multiply(cv2.LUT(s, _neutral_table()), cv2.LUT(v, _valid_table()), scale=1.0 / 255.0)
         wv = wgt.reshape(-1).astype(np.float32)
-        total = float(wv.sum())
+        total = float(np.add.reduce(wv))
         if total < 1e-3 * 255.0 * len(wv):  # nothing near neutral: keep what we have
             break
         mean = (wv @ pixels) / total * gains  # the balanced colour of the neutral surfaces
-        gains = np.clip(gains * mean.mean() / np.maximum(mean, 1e-3), 1.0 / limit, limit)
-    return tuple(float(g) for g in gains)  # type: ignore[return-value]
+        gains = np.minimum(np.maximum(gains * (np.add.reduce(mean) / 3) / np.maximum(mean, 1e-3), 1.0 / limit), limit)
+    return tuple(gains.tolist())  # type: ignore[return-value]
 
 
 @functools.lru_cache(maxsize=1)
