@@ -15,15 +15,15 @@ import numpy as np
 
 def median(values: np.ndarray) -> float:
     """``float(np.median(values))`` of any non-empty array (flattened), by a partial sort."""
-    a = np.asarray(values).ravel()
-    n = a.size
+    part = np.array(values).ravel()  # a copy to partition in place: np.partition's own steps, minus its wrapper
+    n = part.size
     half = n // 2
-    nan_check = a.dtype.kind in "fc"
+    nan_check = part.dtype.kind in "fc"
     if n % 2:
-        part = np.partition(a, (half, n - 1) if nan_check else half)
+        part.partition((half, n - 1) if nan_check else half)
         mid = float(part[half])
     else:
-        part = np.partition(a, (half - 1, half, n - 1) if nan_check else (half - 1, half))
+        part.partition((half - 1, half, n - 1) if nan_check else (half - 1, half))
         # np.mean's arithmetic: in the float type itself, in float64 for integers
         lo, hi = part[half - 1], part[half]
         mid = float((lo + hi) / 2) if nan_check else (float(lo) + float(hi)) / 2.0
@@ -39,10 +39,12 @@ def median_rows(values: np.ndarray) -> np.ndarray:
     half = n // 2
     nan_check = a.dtype.kind in "fc"
     if n % 2:
-        part = np.partition(a, (half, n - 1) if nan_check else half, axis=0)
+        part = a.copy()
+        part.partition((half, n - 1) if nan_check else half, axis=0)
         out = part[half].astype(a.dtype if nan_check else np.float64)
     else:
-        part = np.partition(a, (half - 1, half, n - 1) if nan_check else (half - 1, half), axis=0)
+        part = a.copy()
+        part.partition((half - 1, half, n - 1) if nan_check else (half - 1, half), axis=0)
         lo, hi = part[half - 1], part[half]
         out = (lo + hi) / 2 if nan_check else (lo.astype(np.float64) + hi.astype(np.float64)) / 2
     if nan_check:

@@ -64,11 +64,11 @@ def percentile(values: np.ndarray, pct: float, table: Optional[np.ndarray] = Non
     ``table[values]``, for which only the two order statistics need looking up
     (a non-decreasing map keeps every order statistic).
     """
-    a = values.ravel()
-    pos = pct / 100.0 * (a.size - 1)
+    part = values.flatten()  # a copy to partition in place: np.partition's own steps, minus its wrapper
+    pos = pct / 100.0 * (part.size - 1)
     lo = int(pos)
-    hi = min(lo + 1, a.size - 1)
-    part = np.partition(a, (lo, hi))
+    hi = min(lo + 1, part.size - 1)
+    part.partition((lo, hi))
     low, high = (part[lo], part[hi]) if table is None else (table[part[lo]], table[part[hi]])
     low, high = float(low), float(high)
     t = pos - lo
