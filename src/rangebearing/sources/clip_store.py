@@ -7,9 +7,10 @@ written once to an unlinked temporary file and handed out as a read-only view
 of a shared mapping of it. After the caller is done with a frame (its next
 read), :meth:`ClipStore.release` drops those pages from the process
 (``MADV_DONTNEED``): the next use maps them in again from the page cache,
-which the kernel may also reclaim and read back from the file. Dropping pages
-never changes what a view holds, so a frame kept longer (a recorder, the view
-page) stays valid.
+which the kernel may also reclaim and read back from the file. On a tmpfs
+temp dir the clip stays in RAM, as shared memory outside the process's RSS
+(``TMPDIR`` picks the directory). Dropping pages never changes what a view
+holds, so a frame kept longer (a recorder, the view page) stays valid.
 
 Where the mapping or the temporary file cannot be had (no ``madvise``, a full
 or read-only temp dir), :meth:`ClipStore.put` returns None and the caller
