@@ -43,21 +43,24 @@ def test_misses_names_exactly_the_figures_outside_issue_8s_bounds(harness):
 
 def test_one_command_calibrates_renders_replays_and_caches(harness, tmp_path, capsys):
     work, out = tmp_path / "work", tmp_path / "rows.json"
-    argv = ["--frames", "2", "--cal-frames", "14", "--sets", "paper,crowd-moving", "--workdir", str(work),
-            "--json", str(out)]
+    argv = ["--frames", "2", "--cal-frames", "14", "--sets", "paper,crowd-moving", "--seeds-per-set", "2",
+            "--workdir", str(work), "--json", str(out)]
     assert harness.main(argv) == 0
     text = capsys.readouterr().out
     lines = [ln for ln in text.splitlines() if ln.startswith("| ")]
     assert lines[0] == harness.HEADER and [ln.split(" | ")[0] for ln in lines[1:]] == ["| paper", "| crowd-moving"]
     data = json.loads(out.read_text())
     paper, moving = data["rows"]
-    assert (paper["seed"], paper["frames"], moving["seed"], moving["frames"]) == (6106, 2, 6110, 10)
-    assert paper["findable"] == 2 and paper["found_pct"] == 100.0 and paper["range_mean_pct"] < 1.0
+    # two seeds a set, 20 apart, pooled in one row each
+    assert (paper["seed"], paper["frames"], moving["seed"], moving["frames"]) == ("6106,6126", 4, "6110,6130", 20)
+    assert paper["findable"] == 4 and paper["found_pct"] == 100.0 and paper["range_mean_pct"] < 1.0
+    assert 0.0 <= paper["visible_err_mean"] <= 0.1
     assert "switches_per_1000" in moving and "switches_per_1000" not in paper
+    assert moving["landmark_frames"] > 0 and moving["returns_kept"] <= moving["returns"]
     assert data["calibration"].startswith("calibrated on ")
     # a second run reuses the rendered sets and the calibration frames
     stamps = {p: p.stat().st_mtime_ns for p in work.glob("*/.complete")}
-    assert len(stamps) == 3
+    assert len(stamps) == 5
     assert harness.main([*argv[:-2], "--config", str(next(work.glob("cal-*.yaml")))]) == 0
     assert {p: p.stat().st_mtime_ns for p in work.glob("*/.complete")} == stamps
     assert "not calibrated here" in capsys.readouterr().out

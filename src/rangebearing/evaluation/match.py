@@ -74,6 +74,8 @@ class AccuracyReport:
     visible; all of them when the truth does not say) and ``found_findable`` those
     detected. ``range_cover``/``bearing_cover`` are the shares of detections with
     |error| ≤ 2σ (their own ``range_sigma_m``/``bearing_sigma_rad``); NaN without σ.
+    ``visible_err_*``: the error of the reported ``visible`` against the truth's
+    visible fraction of the silhouette.
     """
 
     frames: int
@@ -90,6 +92,8 @@ class AccuracyReport:
     false_on_empty: int = 0
     range_cover: float = math.nan
     bearing_cover: float = math.nan
+    visible_err_mean: float = math.nan  # |visible − true visible| over hits whose truth says (NaN: none does)
+    visible_err_p95: float = math.nan
 
     @property
     def detection_rate(self) -> float:
@@ -129,6 +133,7 @@ def accuracy(
     r = np.array([m.range_err_pct for m in hits]) if hits else np.array([math.nan])
     b = np.array([m.bearing_err_deg for m in hits]) if hits else np.array([math.nan])
     r_cover, b_cover = _cover(hits)
+    v = np.array([abs(m.found.visible - m.truth.visible) for m in hits if m.truth.visible is not None])
     report = AccuracyReport(
         frames=n_frames,
         truths=len(matches),
@@ -144,6 +149,8 @@ def accuracy(
         false_on_empty=n_false_empty,
         range_cover=r_cover,
         bearing_cover=b_cover,
+        visible_err_mean=float(np.mean(v)) if v.size else math.nan,
+        visible_err_p95=float(np.percentile(v, 95)) if v.size else math.nan,
     )
     return report, matches
 
@@ -161,5 +168,6 @@ def format_report(rep: AccuracyReport) -> str:
             f"bearing error     mean {rep.bearing_err_deg_mean:.3f}°  p95 {rep.bearing_err_deg_p95:.3f}°",
             f"sigma coverage    |err| <= 2 sigma: range {100.0 * rep.range_cover:.1f} %   "
             f"bearing {100.0 * rep.bearing_cover:.1f} %",
+            f"visible error     mean {rep.visible_err_mean:.3f}   p95 {rep.visible_err_p95:.3f}",
         ]
     )
