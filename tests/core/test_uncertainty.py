@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 import pytest
 
@@ -27,6 +28,8 @@ def test_range_sigma_follows_the_spacing_error_through_the_model():
     assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, spread_l_px=0.3) > base
     assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 0.7) > base  # partly hidden
     assert u.range_sigma_m(1.0, 0.014, 30.0, 1.0, 1.0) > base  # noisier edges
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, chroma_blur_px=1.0) > base  # colour blurrier than luma
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, cut=(False, True)) > base  # placed from one limb
     # dominated by the spacing term, sigma/range grows like (d - c)/L: double range, half L, four times
     far = u.range_sigma_m(2.0, 0.0, 15.0, 2.0, 1.0, 1.0)
     near = u.range_sigma_m(1.0, 0.0, 30.0, 2.0, 1.0, 1.0)
@@ -40,10 +43,42 @@ def test_bearing_sigma_grows_with_band_disagreement_hiding_and_splitting():
     assert base >= u.BEARING_FLOOR_RAD
     assert u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, spread_x_px=1.0) > base
     assert u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, visible=0.6) > base
-    split = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut_both=True)
-    assert split > base
+    one = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut=(True, False))
+    split = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut=(True, True))
+    assert one > base and split > base
+    assert u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut=(False, True)) == one
     # off axis a pixel is a smaller angle (cos^2)
     assert u.bearing_sigma_rad(0.5, 2.0, 30.0, 634.0) < u.bearing_sigma_rad(0.0, 2.0, 30.0, 634.0)
+
+
+def _landmark_columns(chroma_sigma_px: float, luma_sigma_px: float = 0.7) -> np.ndarray:
+    """A 100x40 BGR frame: red band rows 10-24, white body 25-64, blue band 65-79 on grey, the same in
+    every column; blurred by ``luma_sigma_px`` (all of it), the colour (YCrCb chroma) by ``chroma_sigma_px`` more."""
+    img = np.full((100, 40, 3), 90, np.uint8)
+    img[10:25] = (40, 40, 200)
+    img[25:65] = (205, 205, 205)
+    img[65:80] = (190, 50, 40)
+    img = cv2.GaussianBlur(img, (1, 0), sigmaX=0.1, sigmaY=luma_sigma_px)
+    if chroma_sigma_px > 0:
+        ycc = cv2.cvtColor(img, cv2.COLOR_BGR2YCrCb)
+        ycc[..., 1:] = cv2.GaussianBlur(ycc[..., 1:], (1, 0), sigmaX=0.1, sigmaY=chroma_sigma_px)
+        img = cv2.cvtColor(ycc, cv2.COLOR_YCrCb2BGR)
+    return img
+
+
+def test_chroma_blur_is_the_colours_blur_beyond_the_brightness():
+    """Blurred alike, the colour is no blurrier than the luma; colour alone smoothed (4:2:0, colour
+    denoise) shows as a blur that grows with the smoothing."""
+    def blur(img):
+        return u.chroma_blur_px(img, (20.0, 17.0), (20.0, 72.0), 30.0, (1.0, 1.0, 1.0))
+
+    alike = blur(_landmark_columns(0.0))
+    assert 0.0 <= alike < 0.35
+    mild, strong = blur(_landmark_columns(0.8)), blur(_landmark_columns(1.6))
+    assert alike < mild < strong
+    assert strong > 1.0
+    # nothing to measure: no reading goes wrong, the term is just absent
+    assert u.chroma_blur_px(np.zeros((6, 6, 3), np.uint8), (3.0, 1.0), (3.0, 4.0), 2.0, (1.0, 1.0, 1.0)) == 0.0
 
 
 def test_pipeline_readings_carry_sigmas_that_grow_with_sensor_noise():

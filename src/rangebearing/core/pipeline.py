@@ -24,6 +24,7 @@ from .denoise import band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, drop_stacked, find_candidates, refine
 from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
+from .limbs import cut_sides
 from .model import in_envelope, reading
 from .pairing import PairingLimits
 from .params import PipelineParams
@@ -31,7 +32,7 @@ from .refine import Pyramid
 from .structure import Candidate
 from .tracking import Track, crossing, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
-from .uncertainty import reading_sigma
+from .uncertainty import chroma_blur_px, reading_sigma
 from .verify import verified
 from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
 
@@ -168,7 +169,7 @@ class Pipeline:
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M
-        readings = sorted((r for r in map(self._reading, found, [cam] * len(found)) if 0 < r[0] <= MAX_RANGE_M),
+        readings = sorted((r for r in (self._reading(c, cam, bgr) for c in found) if 0 < r[0] <= MAX_RANGE_M),
                           key=_range)
         if not self.ids:
             return FrameResult(landmarks=tuple(Landmark(*r) for r in readings), tracked=tracked)
@@ -184,15 +185,16 @@ class Pipeline:
         )
         return FrameResult(landmarks=landmarks, tracked=tracked)
 
-    def _reading(self, c: BandCentroids, cam: CameraIntrinsics) -> tuple:
+    def _reading(self, c: BandCentroids, cam: CameraIntrinsics, bgr: np.ndarray) -> tuple:
         """A :class:`Landmark`'s fields up to ``visible``, in its order (the ids come after)."""
         model = self.params.model
         rng, bearing, d_v, d_h, l_px = reading(c.red_xy_px, c.blue_xy_px, cam, model, self.params.landmark)
         c_m = model.c_m if model.kind == "pinhole" else 0.0
         width_px = c.width_px
-        cut_both = c.candidate is not None and c.candidate.cut_left and c.candidate.cut_right
+        cut = cut_sides(c.candidate, bgr.shape[1]) if c.candidate is not None else (False, False)
+        blur_px = chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px, width_px, self._gains)
         s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px,
-                                 c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut_both)
+                                 c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut, blur_px)
         return (rng, bearing, d_v, d_h, l_px, c.red_xy_px, c.blue_xy_px, width_px, c.bbox_px,
                 in_envelope(rng, bearing, model), s_r, s_b, c.visible)
 
