@@ -312,3 +312,31 @@ def test_freeze_gc_moves_start_up_objects_out_of_the_collector(static_clip):
         assert gc.get_freeze_count() > 1000
     finally:
         gc.unfreeze()
+
+
+def test_the_collector_paused_while_starting_runs_again_after_the_first_frame(static_clip):
+    import gc
+
+    daemon = Daemon(recorded_cfg(static_clip), opener, lambda c: MemoryPublisher(), RecordingNotifier(),
+                    freeze_gc=True)
+    enabled_after_first: List[bool] = []
+    daemon.echo = lambda payload: enabled_after_first.append(gc.isenabled())
+    gc.disable()  # as `rangebearing run` starts (cli.main)
+    try:
+        assert daemon.run() == 0
+        assert gc.isenabled() and enabled_after_first[0] is False and all(enabled_after_first[1:])
+    finally:
+        gc.enable()
+        gc.unfreeze()
+
+
+def test_run_never_leaves_the_collector_off(tmp_path):
+    import gc
+
+    from rangebearing.cli.main import main
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("detection: {downscale: 9}\n", encoding="utf-8")
+    assert gc.isenabled()
+    assert main(["run", "--config", str(bad)]) != 0  # refused before any frame
+    assert gc.isenabled()

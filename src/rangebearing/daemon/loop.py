@@ -204,6 +204,7 @@ class Daemon:
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
             if first and self._freeze_gc:
                 gc.freeze()
+                gc.enable()  # `run` keeps the collector off while starting (cli.main)
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
                 status = dataclasses.asdict(self.summary())
                 self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, status)
