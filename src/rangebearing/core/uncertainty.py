@@ -61,8 +61,8 @@ EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the o
 CHROMA_SHARE = 0.14  # per band centre, share of the colour's own blur (chroma_blur_px)
 MERGED_PX = 1.3  # a band placed from its inner edge and the white height (heights on a curved surface)
 HIDDEN_SHARE_L = 0.05  # share of L per unit of hidden share (the edges' curve over the visible part)
-SPLIT_SHARE_L = 0.03  # share of L: a landmark cut on both sides (split between neighbours)
-CUT_SHARE_L = 0.03  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
+SPLIT_SHARE_L = 0.015  # share of L: a landmark cut on both sides (split between neighbours)
+CUT_SHARE_L = 0.015  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
 MODEL_FLOOR = 0.0002  # relative range error left after calibration
 # bearing: terms of the column's error (px)
 COLUMN_SHARE = 1.25  # of the column measurement's own error (moments, or a limb and half a silhouette)
