@@ -37,12 +37,28 @@ def near_unit(gains: Gains, tol: float = NEAR_UNIT) -> bool:
 
 
 def _same(a: Candidate, b: Candidate) -> bool:
-    """Whether two candidates' red bands share more than half of the smaller one (one landmark)."""
-    ax, ay, aw, ah = a.red_bbox_px
-    bx, by, bw, bh = b.red_bbox_px
-    w = min(ax + aw, bx + bw) - max(ax, bx)
-    h = min(ay + ah, by + bh) - max(ay, by)
-    return w > 0 and h > 0 and w * h > 0.5 * min(aw * ah, bw * bh)
+    """Whether two candidates are one landmark: their columns and their whole red-top-to-blue-bottom
+    spans each share more than half of the smaller one's.
+
+    The two searches can place one landmark's bands a row or two apart (a band's rim pixels are in
+    one class under one balance and not under the other), so its red boxes alone may overlap by
+    less than half. Two landmarks never share most of their columns: the nearer one hides the
+    other there (a robot's body standing under a landmark spans other rows).
+    """
+    return _share(_cols(a), _cols(b)) and _share(_span(a), _span(b))
+
+
+def _cols(c: Candidate) -> Tuple[int, int]:
+    return c.red_bbox_px[0], c.red_bbox_px[0] + c.red_bbox_px[2]
+
+
+def _span(c: Candidate) -> Tuple[int, int]:
+    return c.red_bbox_px[1], c.blue_bbox_px[1] + c.blue_bbox_px[3]
+
+
+def _share(a: Tuple[int, int], b: Tuple[int, int]) -> bool:
+    """Whether the intervals ``[a0, a1)`` and ``[b0, b1)`` share more than half of the shorter one."""
+    return 2 * (min(a[1], b[1]) - max(a[0], b[0])) > min(a[1] - a[0], b[1] - b[0])
 
 
 def merge_candidates(first: Sequence[Candidate], more: Sequence[Candidate], max_landmarks: int) -> List[Candidate]:

@@ -28,7 +28,7 @@ import numpy as np
 from .._compat import frozen
 from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, to_hsv
-from .denoise import majority_filter, median_filter
+from .denoise import band_masks, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
@@ -76,7 +76,7 @@ def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: i
     """Filtered red and blue masks of a downscaled frame: balance, HSV, thresholds, majority filter."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
-    return majority_filter(red, ksize), majority_filter(blue, ksize)
+    return band_masks(red, blue, ksize)
 
 
 def _clipped(small: np.ndarray, gains: Gains) -> Optional[np.ndarray]:
@@ -94,7 +94,7 @@ def find_candidates(
     """Landmark candidates in a frame downscaled by ``cfg.downscale`` (see :mod:`.structure`)."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
-    red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
+    red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
     return candidates(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 

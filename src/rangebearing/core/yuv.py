@@ -29,7 +29,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import UNIT_GAINS, Gains, grey_world_gains, to_hsv
-from .denoise import majority_filter
+from .denoise import band_masks
 from .params import DetectionParams
 from .structure import Candidate, candidates
 from .types import LandmarkGeometry
@@ -259,6 +259,6 @@ def yuv_find_candidates(
     """
     y_half = half_luma(yuv.y) if y_half is None else y_half
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
-    red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
+    red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
     return candidates(red, blue, WindowHsv(y_half, yuv, gains), 2, geometry, cfg.max_landmarks, min_area)
