@@ -50,6 +50,19 @@ def test_candidates_of_the_second_search_are_added_once():
     assert merge_candidates([a], [b], 1) == [a]
 
 
+def test_one_landmark_whose_bands_the_two_searches_place_rows_apart_is_added_once():
+    a = cand(14, y=224, w=16, band=8, white=20)  # red 224-232, blue 252-260
+    b = Candidate((14, 230, 14, 6), (14, 252, 14, 6), 16.0, False, False, False, False, 1.0)  # red boxes share 2 rows
+    assert merge_candidates([a], [b], 8) == [a]
+
+
+def test_landmarks_side_by_side_or_one_on_its_robot_are_not_one():
+    a = cand(10, w=20)
+    assert merge_candidates([a], [cand(31, w=20)], 8) == [a, cand(31, w=20)]  # the next one along
+    below = cand(12, y=90, w=16)  # starts below a's blue band: the robot under it, other rows
+    assert merge_candidates([a], [below], 8) == [a, below]
+
+
 def test_the_camera_balance_is_searched_too_when_grey_world_pulls_far_from_one():
     img, c = frame_with_body((150, 150, 150))
     seen = []

@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 import pytest
 
-from rangebearing.core.denoise import band_preserving_ksize, majority_filter, median_filter
+from rangebearing.core.denoise import band_masks, band_preserving_ksize, majority_filter, median_filter, regrow
 
 
 @pytest.mark.parametrize("k", [3, 5, 7, 15])
@@ -51,3 +51,23 @@ def test_paper_median_15_erases_a_five_pixel_band():
     img = np.full((60, 80, 3), 200, np.uint8)
     img[30:35, 10:70] = (40, 40, 180)
     assert (median_filter(img, 15)[32, 40] == 200).all()
+
+
+def test_regrow_gives_a_thin_band_its_ends_back_and_leaves_specks_removed():
+    raw = np.zeros((12, 20), np.uint8)
+    raw[5:7, 4:9] = 255  # a 2-row band 5 columns wide (a landmark at 2 m, half resolution)
+    raw[1, 15] = 255  # salt
+    filtered = majority_filter(raw, 3)
+    assert np.count_nonzero(filtered[5:7]) == 6  # the vote ate a column at each end
+    out = regrow(filtered, raw, 3)
+    assert np.array_equal(out[5:7, 4:9], raw[5:7, 4:9]) and np.count_nonzero(out) == 10
+    red, blue = band_masks(raw, np.zeros_like(raw), 3)
+    assert np.array_equal(red, out) and not blue.any()
+    assert regrow(filtered, raw, 1) is filtered
+
+
+def test_regrow_keeps_what_the_filter_filled_in():
+    raw = np.full((9, 9), 255, np.uint8)
+    raw[4, 4] = 0  # pepper inside a solid region
+    out = regrow(majority_filter(raw, 3), raw, 3)
+    assert out[4, 4] == 255
