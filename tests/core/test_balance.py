@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from rangebearing.core.balance import balanced_search, merge_candidates, near_unit, white_body_gains
+from rangebearing.core.balance import balanced_search, halfway, merge_candidates, near_unit, white_body_gains
 from rangebearing.core.structure import Candidate
 
 
@@ -72,7 +72,7 @@ def test_the_camera_balance_is_searched_too_when_grey_world_pulls_far_from_one()
         return [c] if near_unit(gains) else []  # found only under the camera's own balance
 
     cands, gains = balanced_search(find, img, (1.45, 1.29, 0.60), 8)
-    assert cands == [c] and seen == [(1.45, 1.29, 0.60), (1.0, 1.0, 1.0)]
+    assert cands == [c] and seen[:2] == [(1.45, 1.29, 0.60), (1.0, 1.0, 1.0)]
     assert gains == pytest.approx((1.0, 1.0, 1.0), abs=0.01)  # the body is grey: measured without a cast
     seen.clear()
     cands, gains = balanced_search(find, img, (1.01, 1.0, 0.99), 8)
@@ -99,3 +99,20 @@ def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
     assert drop_stacked([top, far_away]) == [top, far_away]
     smaller_below = bands(104, 100, spacing=16.0)  # a small fragment on the robot's body under it
     assert drop_stacked([top, smaller_below]) == [top]
+
+
+def test_under_a_strong_cast_half_the_correction_is_searched_too():
+    img, c = frame_with_body((150, 150, 150))
+    grey = (0.71, 1.13, 1.35)  # a blue room: grey-world makes the wall grey and the white bodies orange
+    seen = []
+
+    def find(gains):  # the landmark shows only halfway: the wall out of the blue class, the body still white
+        seen.append(gains)
+        return [c] if all(abs(g - h) < 0.01 for g, h in zip(gains, halfway(grey))) else []
+
+    cands, _ = balanced_search(find, img, grey, 8)
+    assert cands == [c] and seen == [grey, (1.0, 1.0, 1.0), halfway(grey)]
+    assert halfway((4.0, 1.0, 0.25)) == (2.0, 1.0, 0.5)
+    seen.clear()
+    balanced_search(find, img, (1.1, 1.0, 0.92), 8)  # a mild cast: grey-world and the camera's balance only
+    assert len(seen) == 2

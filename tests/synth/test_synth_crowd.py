@@ -86,7 +86,21 @@ def test_far_covers_the_range_and_the_whole_field_of_view():
     assert all(landmark_visibility(s)[0].findable for s in scenes[:30])
 
 
-@pytest.mark.parametrize("preset", ["occlusion", "touching", "crowd", "far"])
+def test_rooms_are_all_red_or_all_blue():
+    scenes = draws("rooms", 12)
+    kinds = set()
+    for s in scenes:
+        floor, wall = np.asarray(s.floor_colour), np.asarray(s.wall_colour)
+        red = floor.argmax() == 0 and wall.argmax() == 0
+        blue = floor.argmax() == 2 and wall.argmax() == 2
+        assert red or blue  # both of one colour: the whole frame cast
+        assert min(floor.max() / floor.min(), wall.max() / wall.min()) > 2.5
+        kinds.add("red" if red else "blue")
+        assert 1 <= len(s.landmarks) <= 3
+    assert kinds == {"red", "blue"}
+
+
+@pytest.mark.parametrize("preset", ["occlusion", "touching", "crowd", "far", "rooms"])
 def test_frames_render_and_truth_lists_what_is_in_view(preset):
     small = CAM.scaled(320, 240)
     for _name, image, rows in generate(2, 5, preset, camera=small):

@@ -10,7 +10,13 @@ statistics, but both leave a landmark findable under one of the two. So:
 
 1. search under the grey-world gains and, when they are not near one, also
    under the camera's own balance (unit gains); keep every landmark either
-   search finds (:func:`merge_candidates`);
+   search finds (:func:`merge_candidates`). Under a strong cast search
+   :func:`halfway` between them as well: in a room of one colour (a blue wall
+   over a navy carpet) the camera leaves the wall blue, so every blue band
+   merges with it, and grey-world makes it grey, which turns the white bodies
+   orange; half the correction takes the wall out of the blue class and
+   leaves the bodies white (and a camera that corrected half of a tungsten
+   cast is right there);
 2. measure with the gains that make the found landmarks' white bodies
    neutral (:func:`white_body_gains`): it is the light *on the landmarks*
    that decides their band colours, not the frame's average.
@@ -27,6 +33,7 @@ from .stats import median_rows
 from .structure import Candidate
 
 NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
+STRONG_CAST = 0.15  # a gain more than 15 % from one: the halfway balance is searched too
 MIN_WHITE_PX = 12  # unclipped, not dark pixels of white body needed for a landmark to vote
 SAMPLES = 16  # rows and columns sampled per white body (the median needs no more)
 
@@ -131,12 +138,20 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
 def balanced_search(
     find: Callable[[Gains], List[Candidate]], bgr: np.ndarray, gains: Gains, max_landmarks: int
 ) -> Tuple[List[Candidate], Gains]:
-    """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too;
-    and the gains to measure them with: their white bodies', else ``gains``.
+    """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too
+    (under a strong cast also :func:`halfway` between them); and the gains to measure them with:
+    their white bodies', else ``gains``.
 
     ``find(gains)`` is the structure search of this frame (BGR or YUV path).
     """
     cands = find(gains)
     if not near_unit(gains):
         cands = merge_candidates(cands, find(UNIT_GAINS), max_landmarks)
+    if not near_unit(gains, STRONG_CAST):
+        cands = merge_candidates(cands, find(halfway(gains)), max_landmarks)
     return cands, white_body_gains(bgr, cands) or gains
+
+
+def halfway(gains: Gains) -> Gains:
+    """The gains halfway (geometrically) between the camera's balance and ``gains``: half the correction."""
+    return tuple(float(np.sqrt(g)) for g in gains)  # type: ignore[return-value]

@@ -85,7 +85,10 @@ def _clipped(small: np.ndarray, gains: Gains) -> Optional[np.ndarray]:
 
 
 SPACING_AGREE = (0.8, 1.25)  # band spacing / (white height · 55/40) of a real landmark
-WHITE_AGREE = 1.3  # white height measured / found by the structure search (2 px steps at ½ resolution)
+WHITE_AGREE = 1.3  # white height measured / found by the structure search (2 px steps at ½ resolution) ...
+# ... give or take one downscaled row: the search counts the blurred rows at both band edges as white and
+# the edges measured under blur (defocus, chroma smoothing) thin a small landmark's body, a third of it at 1.6 m
+WHITE_SLACK_PX = 2.0
 
 
 def find_candidates(
@@ -159,7 +162,7 @@ def combine(
     if not SPACING_AGREE[0] <= spacing_px / max(expected_px, 1e-6) <= SPACING_AGREE[1]:
         return None
     # ... and the white body measured here must be the one the structure search found at 1/downscale
-    if not 1 / WHITE_AGREE <= rows.white_px / max(c.white_px, 1e-6) <= WHITE_AGREE:
+    if not c.white_px / WHITE_AGREE - WHITE_SLACK_PX <= rows.white_px <= c.white_px * WHITE_AGREE + WHITE_SLACK_PX:
         return None
     cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
     if cols is None:

@@ -1,4 +1,4 @@
-"""Presets with Zumo-like robots: ``occlusion``, ``crowd``, ``far`` and ``lighting``.
+"""Presets with Zumo-like robots: ``occlusion``, ``crowd``, ``far``, ``lighting`` and ``rooms``.
 
 ``occlusion``  2–4 robots, 0.2–1.6 m; one is drawn right behind another (its
                landmark's image offset by 0–1.2 half-widths, so from wholly
@@ -10,6 +10,9 @@
 ``lighting``   1–3 robots apart in the image, 0.2–1.5 m, each frame under one of
                :data:`.looks.LIGHT_KINDS` (dim, bright, warm, cool, coloured,
                spotlit, backlit, normal).
+``rooms``      ``lighting`` frames in a room of one strong colour: a red carpet
+               and red brick walls, or a navy carpet and blue walls (the whole
+               frame cast red or blue: grey-world and any camera balance pulled).
 
 Which landmark hides which is left to the geometry; the truth measures it.
 """
@@ -143,3 +146,15 @@ def lighting_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
             scene = dataclasses.replace(base, landmarks=left_to_right(placed))
             return looks.finish(rng, wall_behind(scene, rng, 0.3, 1.2, 0.15), kind)
     raise d.give_up("lighting", camera)
+
+
+# (floor, wall) of a room of one colour: the carpets and walls of :mod:`.looks`, both of one hue
+ROOM_CASTS = {"red": ("red carpet", "red brick"), "blue": ("navy carpet", "blue paint")}
+
+
+def rooms_scene(rng: np.random.Generator, camera: CameraIntrinsics) -> Scene:
+    """One ``rooms`` frame: a ``lighting`` frame whose floor and walls are all red or all blue."""
+    floor, wall = ROOM_CASTS[("red", "blue")[int(rng.integers(2))]]
+    scene = lighting_scene(rng, camera)
+    return dataclasses.replace(scene, floor_colour=d.jitter(rng, looks.FLOORS[floor], 0.015),
+                               wall_colour=d.jitter(rng, looks.WALLS[wall], 0.02))

@@ -41,14 +41,14 @@ from ..errors import SceneError
 from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
-from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene
+from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene, rooms_scene
 from .motion import crowd_sequence
 from .photoreal import PHOTOREAL_HELP, PHOTOREAL_PRESETS, photoreal_scene, photoreal_sequence
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
 from .touching import touching_scene
 
 ORIGINAL_PRESETS = ("paper", "wide", "clutter", "multi", "sample")
-CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving")
+CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving", "rooms")
 PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS
 SAMPLE_FPS = 30.0
 PRESET_HELP = {
@@ -63,6 +63,7 @@ PRESET_HELP = {
     "crowd": "5-8 robots in view, some cut by the frame edges",
     "far": "one robot 0.15-2.0 m over the whole field of view, any light",
     "lighting": "1-3 robots under dim, bright, warm, cool, coloured, spotlit or backlit light",
+    "rooms": "lighting frames in a red room (carpet, brick) or a blue one (navy carpet, blue walls)",
     "crowd-moving": "4-6 robots driving about and crossing each other at 30 fps; truth.csv's "
                     "robot column keeps each robot's identity",
     **PHOTOREAL_HELP,
@@ -170,7 +171,7 @@ def sample_scene(base: Scene, paths: Tuple[Wander, ...], t_s: float) -> Scene:
 
 
 _NEWER = {"occlusion": occlusion_scene, "touching": touching_scene, "crowd": crowd_scene,
-          "far": far_scene, "lighting": lighting_scene}
+          "far": far_scene, "lighting": lighting_scene, "rooms": rooms_scene}
 
 
 def random_scene(rng: np.random.Generator, preset: str,
