@@ -56,6 +56,14 @@ def test_one_landmark_whose_bands_the_two_searches_place_rows_apart_is_added_onc
     assert merge_candidates([a], [b], 8) == [a]
 
 
+def test_of_one_landmark_found_twice_the_taller_white_body_stays():
+    whole = cand(398, y=232, w=14, band=6, white=18)
+    piece = Candidate((402, 234, 8, 4), (402, 248, 8, 6), 10.0, False, True, False, False, 1.0)  # mast in front
+    assert merge_candidates([piece], [whole], 8) == [whole]
+    assert merge_candidates([whole], [piece], 8) == [whole]
+    assert merge_candidates([whole], [cand(399, y=232, w=14, band=6, white=19)], 8) == [whole]  # alike: the first
+
+
 def test_landmarks_side_by_side_or_one_on_its_robot_are_not_one():
     a = cand(10, w=20)
     assert merge_candidates([a], [cand(31, w=20)], 8) == [a, cand(31, w=20)]  # the next one along

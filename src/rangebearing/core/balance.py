@@ -33,6 +33,7 @@ from .stats import median_rows
 from .structure import Candidate
 
 NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
+TALLER = 1.15  # of one landmark found twice, a white body this much taller is the landmark's whole
 STRONG_CAST = 0.15  # a gain more than 15 % from one: the halfway balance is searched too
 MIN_WHITE_PX = 12  # unclipped, not dark pixels of white body needed for a landmark to vote
 SAMPLES = 16  # rows and columns sampled per white body (the median needs no more)
@@ -69,13 +70,19 @@ def _share(a: Tuple[int, int], b: Tuple[int, int]) -> bool:
 
 
 def merge_candidates(first: Sequence[Candidate], more: Sequence[Candidate], max_landmarks: int) -> List[Candidate]:
-    """``first``, then those of ``more`` that are no landmark of ``first``, at most ``max_landmarks`` in all."""
+    """``first``, then those of ``more`` that are no landmark of ``first``, at most ``max_landmarks`` in all.
+
+    Where both searches found one landmark, the one with the clearly taller white body stays: under
+    one balance a mast or flag in front of the body may leave only a smaller red–white–blue piece of
+    it (its band's rim pixels in or out of a class), read as a landmark twice as far.
+    """
     out = list(first[:max_landmarks])
     for c in more:
-        if len(out) >= max_landmarks:
-            break
-        if not any(_same(c, o) for o in out):
+        same = [k for k, o in enumerate(out) if _same(c, o)]
+        if not same and len(out) < max_landmarks:
             out.append(c)
+        elif len(same) == 1 and c.white_px > TALLER * out[same[0]].white_px:
+            out[same[0]] = c
     return out
 
 
