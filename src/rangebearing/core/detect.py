@@ -54,6 +54,8 @@ class BandCentroids:
     spread_l_px: float = 0.0  # ... of L from its row estimators' disagreement (uncertainty.row_spread_px)
     visible: float = 1.0  # share of the landmark's silhouette seen
     candidate: Optional[Candidate] = None  # what the structure search found (tracking measures it again)
+    #: the bands' moments (red, blue) in their boxes, before the edges' rows are combined in (tracking predicts them)
+    moments_px: Optional[Tuple[XY, XY]] = None
 
     @property
     def width_px(self) -> float:
@@ -185,6 +187,7 @@ def combine(
                                   blue.xy_px[1], rows.blue_y_px, rows.blue_merged),
         visible=c.visible,
         candidate=c,
+        moments_px=(red.xy_px, blue.xy_px),
     )
 
 

@@ -85,14 +85,14 @@ class BandEdges:
 
 def band_rows(
     p2d: np.ndarray, top: int, bottom: int, inner_down: bool, white_end: int, outer_end: int,
-    p: Optional[np.ndarray] = None,
+    p: Optional[np.ndarray] = None, column_sigma: bool = True,
 ) -> Optional[BandEdges]:
     """Measure one band in a (rows, cols) excess array whose rows ``top..bottom`` are its expected rows.
 
     ``inner_down``: the inner (white) edge is below the band (red); otherwise above (blue).
     ``white_end`` is the row in the white body where the inner integral stops; ``outer_end`` the
     last background row beyond the outer edge (clipped to the array). ``p`` is ``p2d.mean(axis=1)``
-    when the caller has it already.
+    when the caller has it already. ``column_sigma=False``: ``sigma`` is NaN, not measured.
     """
     p = mean_along(p2d, 1) if p is None else p
     n = len(p)
@@ -118,7 +118,7 @@ def band_rows(
         merged = outer_end <= mid or level - o_bg < MERGE_CONTRAST * level
         outer = inner if merged else edge_down(p, mid + 1, outer_end, level, o_bg)
     centre = 0.5 * (inner + outer)
-    sigma = _column_sigma(p2d, level, w_bg, mid, white_end, inner_down)
+    sigma = _column_sigma(p2d, level, w_bg, mid, white_end, inner_down) if column_sigma else float("nan")
     return BandEdges(centre, inner, merged, sigma)
 
 

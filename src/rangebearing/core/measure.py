@@ -87,9 +87,12 @@ def _row_window(shape: Tuple[int, ...], c: Candidate, geometry: LandmarkGeometry
 
 def measure_rows_all(
     bgr: np.ndarray, cands: Sequence[Candidate], gains: Gains, geometry: LandmarkGeometry,
-    xs_px: Sequence[Optional[float]],
+    xs_px: Sequence[Optional[float]], column_sigma: bool = True,
 ) -> List[Optional[Rows]]:
     """:func:`measure_rows` of every candidate of a frame (``xs_px``: each one's ``x_px``).
+
+    ``column_sigma=False`` skips the column-scatter noise of the edges (``sigma_l_px``
+    is then NaN): tracking keeps the one its last full scan measured.
 
     The candidates' tiles are stacked one below the other, so the conversion to
     linear-light excess and the column weighting run once for all of them; each
@@ -136,12 +139,13 @@ def measure_rows_all(
             out.append(None)
             continue
         o, n, m = offs[j], tiles[j].shape[0], tiles[j].shape[1]
-        out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m]))
+        out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m], column_sigma))
         j += 1
     return out
 
 
-def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb: np.ndarray) -> Optional[Rows]:
+def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb: np.ndarray,
+          column_sigma: bool = True) -> Optional[Rows]:
     """A candidate's :class:`Rows` from its weighted excess tiles (``oy``: the tiles' first frame row)."""
     white_m = geometry.height_m - 2 * geometry.band_height_m
     band_px = c.white_px * geometry.band_height_m / white_m
@@ -151,8 +155,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     hb, hw = band_px / f, c.white_px / f
     r_exp = (ry + 0.5 * rh - oy) / f - 0.5
     b_exp = (by + 0.5 * bh - oy) / f - 0.5
-    red = _band(er, mean_along(er, 1), r_exp, hb, hw, True)
-    blue = _band(eb, mean_along(eb, 1), b_exp, hb, hw, False)
+    red = _band(er, mean_along(er, 1), r_exp, hb, hw, True, column_sigma)
+    blue = _band(eb, mean_along(eb, 1), b_exp, hb, hw, False, column_sigma)
     if red is None or blue is None or not blue.inner > red.inner:
         return None
     white = blue.inner - red.inner
@@ -204,7 +208,8 @@ def _box(k: int) -> np.ndarray:
     return box
 
 
-def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool):
+def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool,
+          column_sigma: bool = True):
     """:func:`.edges.band_rows` around the row of strongest colour near ``expected`` (``p``: the row profile)."""
     n = p2d.shape[0]
     lo, hi = max(0, int(expected - 0.5 * hb - 3)), min(n, int(expected + 0.5 * hb + 4))
@@ -227,8 +232,8 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
     into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther
     beyond = round(0.5 * hb + 3)
     if red:
-        return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p)
-    return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p)
+        return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p, column_sigma)
+    return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p, column_sigma)
 
 
 __all__ = [

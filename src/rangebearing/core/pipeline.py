@@ -30,7 +30,7 @@ from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .structure import Candidate
-from .tracking import Track, crossing, step
+from .tracking import Track, crossing, rescanned, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import chroma_blur_px, reading_sigma
 from .verify import verified
@@ -165,7 +165,7 @@ class Pipeline:
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
                 if self.track:
                     self._hidden = still_hidden(self._tracks, self._hidden, found, det.full_scan_every)
-                self._tracks = [Track(c) for c in found] if self.track else []
+                self._tracks = rescanned(self._tracks, found) if self.track else []
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M

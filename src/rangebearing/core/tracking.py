@@ -8,16 +8,14 @@ when both bands are found with about the same weight (area) as before and still
 in the landmark's geometry; otherwise it is lost and the caller scans the whole
 frame next.
 
-Near the frame's edge the moments of what is left lag the landmark (they move
-by about half its motion while it runs out), so there the band's columns are
-measured afresh (:func:`edge_run`): its box then ends at the frame's edge, which
-makes it cut on that side (:func:`.limbs.cut_sides`), and ``visible`` is the
-share of it still in the frame, as a full scan would have it.
+Near the frame's edge a landmark is re-cut there (:mod:`.frame_edge`), as a
+full scan would have it.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -25,16 +23,17 @@ import numpy as np
 from .._compat import frozen
 from .color import Gains
 from .detect import BandCentroids, combine
-from .edges import excess, limb, linear_table
-from .limbs import FRAME_EDGE_PX, _tile, thin_step
-from .measure import measure_rows_all
+from .frame_edge import near_edge, recut
+from .measure import Rows, measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
-from .structure import MIN_VISIBLE, Candidate
+from .structure import Candidate
 from .types import XY, BBox, LandmarkGeometry
 
 MASS_RATIO = (0.6, 1.6)  # a band's weight may change this much between frames
+WIDTH_RATIO = 1.6  # a landmark found again by a full scan: about as wide as it was
+ON_TARGET_PX = 1.5  # a band measured this close to its predicted place was whole inside its tight window
 
 
 @frozen
@@ -43,20 +42,52 @@ class Track:
 
     bands: BandCentroids
     velocity_px: XY = (0.0, 0.0)
-    #: the bands' moments (red, blue) measured in the last tracked frame; ``None`` right after a full scan
+    #: the bands' moments (red, blue) measured in the last tracked frame; ``None``: the full scan's (``bands``)
     moments_px: Optional[Tuple[XY, XY]] = None
 
 
-def _origin(t: Track) -> BandCentroids:
-    """The bands to move the boxes from: at the moments last measured, so a box moves as its moments move.
+def _origin(t: Track) -> Tuple[XY, XY]:
+    """The (red, blue) points to move the boxes from: the moments last measured, so a box moves as its moments move.
 
     A band's row is the mean of its moment and its edges (:func:`.detect.combine`):
     moving the box by the moment's step from that mean would add half their
     difference to the box every frame, and the box would walk off the band.
     """
-    if t.moments_px is None:
-        return t.bands
-    return dataclasses.replace(t.bands, red_xy_px=t.moments_px[0], blue_xy_px=t.moments_px[1])
+    if t.moments_px is not None:
+        return t.moments_px
+    b = t.bands
+    return b.moments_px if b.moments_px is not None else (b.red_xy_px, b.blue_xy_px)
+
+
+def rescanned(before: Sequence[Track], found: Sequence[BandCentroids]) -> List[Track]:
+    """Tracks for a full scan's landmarks, each moving as the track it continues moved (a newcomer stands still).
+
+    The landmark a track continues is the one nearest its predicted place, within
+    half a width of it and about as wide; its velocity is its step since the last
+    frame. Started from rest, a moving landmark's first windows would lag it by
+    its speed.
+    """
+    out, used = [], set()
+    for c in found:
+        cx, cy = _middle(c)
+        best, gap = None, 0.5 * c.width_px
+        for k, t in enumerate(before):
+            tx, ty = _middle(t.bands)
+            d = max(abs(tx + t.velocity_px[0] - cx), abs(ty + t.velocity_px[1] - cy))
+            ratio = c.width_px / max(t.bands.width_px, 1e-6)
+            if k not in used and d <= gap and 1 / WIDTH_RATIO <= ratio <= WIDTH_RATIO:
+                best, gap = k, d
+        if best is None:
+            out.append(Track(c))
+            continue
+        used.add(best)
+        tx, ty = _middle(before[best].bands)
+        out.append(Track(c, (cx - tx, cy - ty)))
+    return out
+
+
+def _middle(c: BandCentroids) -> XY:
+    return 0.5 * (c.red_xy_px[0] + c.blue_xy_px[0]), 0.5 * (c.red_xy_px[1] + c.blue_xy_px[1])
 
 
 def _moved(box: BBox, dx: float, dy: float) -> BBox:
@@ -120,94 +151,31 @@ def advance(old: Track, now: BandCentroids, moments_px: Optional[Tuple[XY, XY]] 
     return Track(now, (0.5 * (rdx + bdx), 0.5 * (rdy + bdy)), moments_px)
 
 
-def _moved_bands(old: BandCentroids, red: BandFix, blue: BandFix) -> Tuple[BBox, BBox]:
-    """The old band boxes moved as the moments moved."""
-    rdx, rdy = red.xy_px[0] - old.red_xy_px[0], red.xy_px[1] - old.red_xy_px[1]
-    bdx, bdy = blue.xy_px[0] - old.blue_xy_px[0], blue.xy_px[1] - old.blue_xy_px[1]
-    return _moved(old.red_bbox_px, rdx, rdy), _moved(old.blue_bbox_px, bdx, bdy)
+def _moved_bands(old: BandCentroids, origin: Tuple[XY, XY], red: BandFix, blue: BandFix) -> Tuple[BBox, BBox]:
+    """The old band boxes moved as the moments moved (from ``origin``, :func:`_origin`)."""
+    (rx, ry), (bx, by) = origin
+    return (_moved(old.red_bbox_px, red.xy_px[0] - rx, red.xy_px[1] - ry),
+            _moved(old.blue_bbox_px, blue.xy_px[0] - bx, blue.xy_px[1] - by))
 
 
-def remeasure(
-    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry,
-    fy_px: float,
-) -> Optional[BandCentroids]:
-    """The bands measured as a full scan would: moments plus edges, in boxes that follow the moments."""
-    if old.candidate is None:
-        return _moved_only(old, red, blue)
-    cand = _moved_candidate(bgr, old, red, blue, gains, geometry)
-    if cand is None:
-        return None
-    return combine(bgr, cand, red, blue, gains, geometry, fy_px)  # chroma refs: the ones measure_bands was given
-
-
-def _moved_only(old: BandCentroids, red: BandFix, blue: BandFix) -> BandCentroids:
+def _moved_only(old: BandCentroids, origin: Tuple[XY, XY], red: BandFix, blue: BandFix) -> BandCentroids:
     """A track without a structure candidate (the paper's path): the moments moved, nothing re-measured."""
-    rb, bb = _moved_bands(old, red, blue)
+    rb, bb = _moved_bands(old, origin, red, blue)
     return dataclasses.replace(old, red_xy_px=red.xy_px, blue_xy_px=blue.xy_px, red_bbox_px=rb, blue_bbox_px=bb,
                                red_mass_px=red.mass_px, blue_mass_px=blue.mass_px)
 
 
 def _moved_candidate(
-    bgr: np.ndarray, old: BandCentroids, red: BandFix, blue: BandFix, gains: Gains, geometry: LandmarkGeometry
+    bgr: np.ndarray, old: BandCentroids, origin: Tuple[XY, XY], red: BandFix, blue: BandFix, gains: Gains,
+    geometry: LandmarkGeometry,
 ) -> Optional[Candidate]:
     """The old candidate with its boxes moved as the moments moved, re-cut at the frame's edge
-    (:func:`edge_run`); ``None`` when too little of it is left in the frame for a full scan to report it."""
-    rb, bb = _moved_bands(old, red, blue)
+    (:func:`.frame_edge.recut`); ``None`` when too little of it is left in the frame for a full scan to report it."""
+    rb, bb = _moved_bands(old, origin, red, blue)
     cand = dataclasses.replace(old.candidate, red_bbox_px=rb, blue_bbox_px=bb)
-    mx = motion_margin(rb)[0]
-    if rb[0] - mx > FRAME_EDGE_PX and rb[0] + rb[2] + mx < bgr.shape[1] - FRAME_EDGE_PX:
+    if not near_edge(rb, motion_margin(rb)[0], bgr.shape[1]):
         return cand
-    run = edge_run(bgr, cand, red.xy_px[0], gains, geometry)
-    if run is None:  # near the edge, not at it: the boxes only kept inside the frame
-        w = bgr.shape[1]
-        return dataclasses.replace(cand, red_bbox_px=_clipped(rb, w), blue_bbox_px=_clipped(bb, w))
-    x0, x1, visible = run
-    if visible < MIN_VISIBLE:
-        return None
-    return dataclasses.replace(cand, red_bbox_px=(x0, rb[1], x1 - x0, rb[3]), blue_bbox_px=(x0, bb[1], x1 - x0, bb[3]),
-                               visible=visible)
-
-
-def _clipped(box: BBox, frame_w_px: int) -> BBox:
-    x0, x1 = max(0, box[0]), min(frame_w_px, box[0] + box[2])
-    return (x0, box[1], max(1, x1 - x0), box[3])
-
-
-def edge_run(
-    bgr: np.ndarray, c: Candidate, core_x_px: float, gains: Gains, geometry: LandmarkGeometry
-) -> Optional[Tuple[int, int, float]]:
-    """``(x0, x1, visible)``: the red band's columns in this frame (end exclusive) and their share of the
-    silhouette, for a landmark that may run off the frame's edge; ``None`` when no side reaches the edge.
-
-    The band's chromaticity profile (as :func:`.limbs.measure_columns` takes it) is
-    followed from ``core_x_px`` (inside the band: its moments) out to each limb
-    (:func:`.edges.limb`); a side that never falls to half the band's level before
-    the frame ends is cut by the edge. A side that falls nowhere short of the
-    frame's edge keeps the candidate's box.
-    """
-    _h, w = bgr.shape[:2]
-    rx, ry, rw, rh = c.red_bbox_px
-    silhouette_px = c.white_px * geometry.diameter_m / (geometry.height_m - 2 * geometry.band_height_m)
-    reach = round(silhouette_px) + motion_margin(c.red_bbox_px)[0]
-    y0, y1 = int(ry + 0.2 * rh), int(ry + 0.8 * rh) + 1
-    tile, ox, _ = _tile(bgr, rx - reach, y0, rx + rw + reach, y1, row_step=thin_step(y1 - y0))
-    n = tile.shape[1]
-    if n < 4 or tile.shape[0] == 0:
-        return None
-    er, _ = excess(tile, gains)
-    q = (er / np.maximum(linear_table()[tile].sum(axis=2), 1e-3)).mean(axis=0)
-    core = max(0, min(n - 1, round(core_x_px) - ox))
-    level = float(np.median(q[max(0, core - 2) : core + 3]))
-    left, right = limb(q, core, 0, level), limb(q, core, n - 1, level)
-    at_left = ox == 0 and not np.isfinite(left)
-    at_right = ox + n == w and not np.isfinite(right)
-    if not (at_left or at_right):
-        return None
-    x0 = 0 if at_left else round(ox + left) if np.isfinite(left) else max(0, rx)
-    x1 = w if at_right else round(ox + right) + 1 if np.isfinite(right) else min(w, rx + rw)
-    if x1 - x0 < 2:
-        return None
-    return x0, x1, min(1.0, (x1 - x0 + 1) / silhouette_px)
+    return recut(bgr, cand, red.xy_px[0], gains, geometry)
 
 
 def step(
@@ -221,22 +189,28 @@ def step(
 ) -> Tuple[List[Track], bool]:
     """Follow every track into this frame; returns the surviving tracks and whether any was lost.
 
-    Each followed landmark is measured as :func:`remeasure` does, all of them in
-    one batch (:func:`.measure.measure_rows_all`). The bands' chroma references
-    are the ones kept from the last full scan: ``measure_bands`` returns them as given.
+    Each band is measured first in its predicted box with a full scan's margins
+    (:func:`_predicted`); a track whose bands are not where it predicted is looked
+    for again in a window grown by the motion margin and then measured as
+    :func:`_tight` does. Each followed landmark is then measured as
+    :func:`remeasure` does, all of them in one batch
+    (:func:`.measure.measure_rows_all`). The bands' chroma references are the
+    ones kept from the last full scan: ``measure_bands`` returns them as given.
     """
-    boxes: List[BBox] = []
-    refs: List[float] = []
-    for t in tracks:
-        boxes.extend(search_boxes(t))
-        refs.extend((t.bands.red_chroma, t.bands.blue_chroma))  # kept from the last full scan
-    margins = [motion_margin(b) for b in boxes]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), margins, cfg, gains, refs=refs)
-    found = [(t, red, blue) for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2])
-             if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
-    found = _tight(bgr, found, cfg, gains, geometry, limits)
+    found, astray = _predicted(bgr, tracks, cfg, gains, geometry, limits)
+    if astray:
+        boxes = [b for t in astray for b in search_boxes(t)]
+        refs = [r for t in astray for r in (t.bands.red_chroma, t.bands.blue_chroma)]
+        fixes = measure_bands(bgr, boxes, [True, False] * len(astray), [motion_margin(b) for b in boxes], cfg, gains,
+                              refs=refs)
+        wide = [(t, red, blue) for t, red, blue in zip(astray, fixes[0::2], fixes[1::2])
+                if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
+        found = found + _tight(bgr, wide, cfg, gains, geometry, limits)
+        order = {id(t): k for k, t in enumerate(tracks)}
+        found.sort(key=lambda f: order[id(f[0])])  # track order: _distinct keeps the earlier of two
     lost = len(found) < len(tracks)
-    cands = [_moved_candidate(bgr, _origin(t), red, blue, gains, geometry) if t.bands.candidate is not None else None
+    cands = [_moved_candidate(bgr, t.bands, _origin(t), red, blue, gains, geometry)
+             if t.bands.candidate is not None else None
              for t, red, blue in found]
     gone = [k for k, (t, _, _) in enumerate(found) if t.bands.candidate is not None and cands[k] is None]
     if gone:  # ran off the frame: no reading, as a full scan would give none
@@ -244,20 +218,76 @@ def step(
         found = [f for k, f in enumerate(found) if k not in gone]
         cands = [c for k, c in enumerate(cands) if k not in gone]
     with_cand = [k for k, c in enumerate(cands) if c is not None]
+    # the edges' noise (sigma_l_px) is not measured again: it is the last full scan's (see _noise)
     rows = measure_rows_all(bgr, [cands[k] for k in with_cand], gains, geometry,
-                            [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand])
+                            [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand], False)
     row_of = dict(zip(with_cand, rows))
     kept: List[Track] = []
     for k, ((t, red, blue), cand) in enumerate(zip(found, cands)):
         if cand is None:
-            now: Optional[BandCentroids] = _moved_only(_origin(t), red, blue)
+            now: Optional[BandCentroids] = _moved_only(t.bands, _origin(t), red, blue)
         else:
-            now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, row_of[k])
+            now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, _noise(row_of[k], t.bands, cand))
         if now is None:
             lost = True
             continue
         kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
     return _distinct(kept), lost
+
+
+def _noise(rows: Optional[Rows], before: BandCentroids, now: Candidate) -> Optional[Rows]:
+    """``rows`` with the edges' noise of ``before`` (``sigma_l_px``), for the width the landmark has ``now``.
+
+    The scatter of the per-column edges is the landmark's own pixel noise over its
+    columns: it changes as slowly as its size does, so a full scan measures it and
+    the tracked frames after it keep it, scaled as the standard error of a mean over
+    the columns (1/√width). Tracked frames skip its per-band fit.
+    """
+    if rows is None:
+        return None
+    width_px = 0.5 * (now.red_bbox_px[2] + now.blue_bbox_px[2])
+    return dataclasses.replace(rows, sigma_l_px=before.sigma_l_px * math.sqrt(before.width_px / max(width_px, 1e-6)))
+
+
+def _tight_margins(boxes: Sequence[BBox], cfg: DetectionParams) -> List[Margin]:
+    """A full scan's margins (:func:`.detect.refine`) around each band box."""
+    m = cfg.downscale + 1
+    return [(m, m + b[3] // 4) for b in boxes]
+
+
+def _predicted(
+    bgr: np.ndarray, tracks: Sequence[Track], cfg: DetectionParams, gains: Gains, geometry: LandmarkGeometry,
+    limits: PairingLimits,
+) -> Tuple[List[Tuple[Track, BandFix, BandFix]], List[Track]]:
+    """Each track's bands measured in their predicted boxes with a full scan's margins, kept where the
+    moments came out within ``ON_TARGET_PX`` of the prediction; the rest (astray) are returned apart.
+
+    A band that lies where its track predicted sits whole inside a window grown
+    only by a full scan's margins, so it is measured in one pass from the same
+    pixels a full scan reads; one that strayed may be cut by that window, and is
+    looked for again in a wider one.
+    """
+    if not tracks:
+        return [], []
+    boxes = [b for t in tracks for b in search_boxes(t)]
+    refs = [r for t in tracks for r in (t.bands.red_chroma, t.bands.blue_chroma)]
+    fixes = measure_bands(bgr, boxes, [True, False] * len(tracks), _tight_margins(boxes, cfg), cfg, gains, refs=refs)
+    found, astray = [], []
+    for t, red, blue in zip(tracks, fixes[0::2], fixes[1::2]):
+        if (red is not None and blue is not None and _on_target(t, red, blue)
+                and plausible(t.bands, red, blue, geometry, limits)):
+            found.append((t, red, blue))
+        else:
+            astray.append(t)
+    return found, astray
+
+
+def _on_target(t: Track, red: BandFix, blue: BandFix) -> bool:
+    """Both bands' moments within ``ON_TARGET_PX`` of where the track's velocity put them."""
+    (rx, ry), (bx, by) = _origin(t)
+    vx, vy = t.velocity_px
+    return (abs(red.xy_px[0] - rx - vx) <= ON_TARGET_PX and abs(red.xy_px[1] - ry - vy) <= ON_TARGET_PX
+            and abs(blue.xy_px[0] - bx - vx) <= ON_TARGET_PX and abs(blue.xy_px[1] - by - vy) <= ON_TARGET_PX)
 
 
 def _tight(
@@ -274,11 +304,9 @@ def _tight(
     """
     if not found:
         return found
-    m = cfg.downscale + 1
-    boxes = [b for t, red, blue in found for b in _moved_bands(_origin(t), red, blue)]
+    boxes = [b for t, red, blue in found for b in _moved_bands(t.bands, _origin(t), red, blue)]
     refs = [r for t, _, _ in found for r in (t.bands.red_chroma, t.bands.blue_chroma)]
-    fixes = measure_bands(bgr, boxes, [True, False] * len(found), [(m, m + b[3] // 4) for b in boxes], cfg, gains,
-                          refs=refs)
+    fixes = measure_bands(bgr, boxes, [True, False] * len(found), _tight_margins(boxes, cfg), cfg, gains, refs=refs)
     return [(t, red, blue) for (t, _, _), red, blue in zip(found, fixes[0::2], fixes[1::2])
             if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
 
