@@ -26,6 +26,7 @@ from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
 from .model import in_envelope, reading
+from .newcomers import SideCounts, came_in, side_colour
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
@@ -89,8 +90,10 @@ class Pipeline:
         to do with the earlier ones (another recording).
         """
         self._tracks: List[Track] = []
+        self._lost: List[Track] = []  # tracks the last (tracked) frame lost
         self._hidden: List[Hidden] = []
         self._since_scan = 0
+        self._sides: SideCounts = (0, 0)
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
 
@@ -133,11 +136,14 @@ class Pipeline:
             found = detect_paper(bgr, det)
         else:
             tracking = self.track and self._tracks and self._since_scan < det.full_scan_every - 1
-            # landmarks crossing, or one coming out from behind another: measured by a full scan
-            if tracking and not crossing([*self._tracks, *tracks_of(self._hidden)]):
-                self._tracks, lost = step(
+            # landmarks crossing, one coming out from behind another, or one coming into view: a full scan
+            if (tracking and not crossing([*self._tracks, *tracks_of(self._hidden)])
+                    and not came_in(side_colour(bgr, det, self._gains, [t.reach_px for t in self._tracks]),
+                                    self._sides)):
+                self._tracks, self._lost = step(
                     bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
                 )
+                lost = bool(self._lost)
                 # a lost landmark may be just outside its window: scan the whole frame next time
                 self._since_scan = det.full_scan_every if lost else self._since_scan + 1
                 found = [t.bands for t in self._tracks]
@@ -164,8 +170,11 @@ class Pipeline:
                 found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
                 if self.track:
-                    self._hidden = still_hidden(self._tracks, self._hidden, found, det.full_scan_every)
-                self._tracks = rescanned(self._tracks, found) if self.track else []
+                    self._hidden = still_hidden([*self._tracks, *self._lost], self._hidden, found, det.full_scan_every)
+                self._tracks = rescanned(self._tracks, found, self._lost) if self.track else []
+                self._lost = []
+                if self.track:  # what the sides hold now, the landmarks found blanked (core/newcomers.py)
+                    self._sides = side_colour(bgr, det, self._gains, [t.reach_px for t in self._tracks])
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M

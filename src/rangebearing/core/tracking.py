@@ -45,6 +45,14 @@ class Track:
     #: the bands' moments (red, blue) measured in the last tracked frame; ``None``: the full scan's (``bands``)
     moments_px: Optional[Tuple[XY, XY]] = None
 
+    @property
+    def reach_px(self) -> BBox:
+        """The whole landmark's box where it is predicted this frame, grown by the motion margin."""
+        red, blue = search_boxes(self)
+        x0, y0, x1, y1 = min(red[0], blue[0]), red[1], max(red[0] + red[2], blue[0] + blue[2]), blue[1] + blue[3]
+        mx, my = motion_margin(red)
+        return (x0 - mx, y0 - my, x1 - x0 + 2 * mx, y1 - y0 + 2 * my)
+
 
 def _origin(t: Track) -> Tuple[XY, XY]:
     """The (red, blue) points to move the boxes from: the moments last measured, so a box moves as its moments move.
@@ -59,21 +67,24 @@ def _origin(t: Track) -> Tuple[XY, XY]:
     return b.moments_px if b.moments_px is not None else (b.red_xy_px, b.blue_xy_px)
 
 
-def rescanned(before: Sequence[Track], found: Sequence[BandCentroids]) -> List[Track]:
+def rescanned(before: Sequence[Track], found: Sequence[BandCentroids], lost: Sequence[Track] = ()) -> List[Track]:
     """Tracks for a full scan's landmarks, each moving as the track it continues moved (a newcomer stands still).
 
-    The landmark a track continues is the one nearest its predicted place, within
-    half a width of it and about as wide; its velocity is its step since the last
-    frame. Started from rest, a moving landmark's first windows would lag it by
-    its speed.
+    ``before`` are the tracks of the last frame, ``lost`` those the frame before
+    it lost (a track lost in a window is scanned for the next frame). The
+    landmark a track continues is the one nearest its predicted place, within
+    half a width of it and about as wide; its velocity is its step since the
+    track was last measured. Started from rest, a moving landmark's first
+    windows would lag it by its speed.
     """
+    known = [(t, 1) for t in before] + [(t, 2) for t in lost]
     out, used = [], set()
     for c in found:
         cx, cy = _middle(c)
         best, gap = None, 0.5 * c.width_px
-        for k, t in enumerate(before):
+        for k, (t, age) in enumerate(known):
             tx, ty = _middle(t.bands)
-            d = max(abs(tx + t.velocity_px[0] - cx), abs(ty + t.velocity_px[1] - cy))
+            d = max(abs(tx + age * t.velocity_px[0] - cx), abs(ty + age * t.velocity_px[1] - cy))
             ratio = c.width_px / max(t.bands.width_px, 1e-6)
             if k not in used and d <= gap and 1 / WIDTH_RATIO <= ratio <= WIDTH_RATIO:
                 best, gap = k, d
@@ -81,8 +92,9 @@ def rescanned(before: Sequence[Track], found: Sequence[BandCentroids]) -> List[T
             out.append(Track(c))
             continue
         used.add(best)
-        tx, ty = _middle(before[best].bands)
-        out.append(Track(c, (cx - tx, cy - ty)))
+        t, age = known[best]
+        tx, ty = _middle(t.bands)
+        out.append(Track(c, ((cx - tx) / age, (cy - ty) / age)))
     return out
 
 
@@ -186,13 +198,15 @@ def step(
     geometry: LandmarkGeometry,
     limits: PairingLimits,
     fy_px: float = 634.0,
-) -> Tuple[List[Track], bool]:
-    """Follow every track into this frame; returns the surviving tracks and whether any was lost.
+) -> Tuple[List[Track], List[Track]]:
+    """Follow every track into this frame; returns the surviving tracks and those lost (the caller scans
+    the whole frame next).
 
     Each band is measured first in its predicted box with a full scan's margins
     (:func:`_predicted`); a track whose bands are not where it predicted is looked
     for again in a window grown by the motion margin and then measured as
-    :func:`_tight` does. Each followed landmark is then measured as
+    :func:`_tight` does (that window may hold a background of the band's colour,
+    so only the tight measurement must keep the band's weight). Each followed landmark is then measured as
     :func:`remeasure` does, all of them in one batch
     (:func:`.measure.measure_rows_all`). The bands' chroma references are the
     ones kept from the last full scan: ``measure_bands`` returns them as given.
@@ -204,17 +218,15 @@ def step(
         fixes = measure_bands(bgr, boxes, [True, False] * len(astray), [motion_margin(b) for b in boxes], cfg, gains,
                               refs=refs)
         wide = [(t, red, blue) for t, red, blue in zip(astray, fixes[0::2], fixes[1::2])
-                if red is not None and blue is not None and plausible(t.bands, red, blue, geometry, limits)]
+                if red is not None and blue is not None]
         found = found + _tight(bgr, wide, cfg, gains, geometry, limits)
         order = {id(t): k for k, t in enumerate(tracks)}
         found.sort(key=lambda f: order[id(f[0])])  # track order: _distinct keeps the earlier of two
-    lost = len(found) < len(tracks)
     cands = [_moved_candidate(bgr, t.bands, _origin(t), red, blue, gains, geometry)
              if t.bands.candidate is not None else None
              for t, red, blue in found]
     gone = [k for k, (t, _, _) in enumerate(found) if t.bands.candidate is not None and cands[k] is None]
     if gone:  # ran off the frame: no reading, as a full scan would give none
-        lost = True
         found = [f for k, f in enumerate(found) if k not in gone]
         cands = [c for k, c in enumerate(cands) if k not in gone]
     with_cand = [k for k, c in enumerate(cands) if c is not None]
@@ -223,16 +235,17 @@ def step(
                             [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand], False)
     row_of = dict(zip(with_cand, rows))
     kept: List[Track] = []
+    followed = set()
     for k, ((t, red, blue), cand) in enumerate(zip(found, cands)):
         if cand is None:
             now: Optional[BandCentroids] = _moved_only(t.bands, _origin(t), red, blue)
         else:
             now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, _noise(row_of[k], t.bands, cand))
         if now is None:
-            lost = True
             continue
         kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
-    return _distinct(kept), lost
+        followed.add(id(t))
+    return _distinct(kept), [t for t in tracks if id(t) not in followed]
 
 
 def _noise(rows: Optional[Rows], before: BandCentroids, now: Candidate) -> Optional[Rows]:

@@ -1,0 +1,80 @@
+"""Newcomers at the frame's sides: band colour appearing where no followed landmark is.
+
+Window tracking measures only the landmarks it follows, so a landmark coming
+into view waits for the next scheduled full scan, up to ``full_scan_every - 1``
+frames, though it is findable from the frame it is 60 % in view. Landmarks
+come into view at the frame's left and right sides (a neighbour driving in, the
+observer turning). Each frame the two side strips are classified at the full
+scan's half resolution (a few small calls: two strips of ``EDGE_STRIP_PX``
+columns), the followed landmarks' boxes are blanked, and the columns left that
+hold red above blue, as a landmark's do, are counted. A full scan records the
+counts it leaves; when a side gains ``NEW_COLUMNS`` of them, something like a
+landmark came in there, and the caller scans the whole frame.
+
+A wall of one colour, or a robot's body passing in front of it, makes no such
+column. Red over blue things at the side only raise the counts the scan
+records; they trigger nothing until they change. A landmark not yet findable
+when the scan runs is in the recorded counts, and triggers the next scan by
+growing further as it comes in.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence, Tuple
+
+import numpy as np
+
+from .color import Gains, apply_gains, class_masks, to_hsv
+from .params import DetectionParams
+from .types import BBox
+
+EDGE_STRIP_PX = 48  # full-resolution columns: 60 % of the nearest landmark's width (0.45 m) fits in
+NEW_COLUMNS = 2  # half-resolution columns: 60 % of a landmark at 2 m is about 3
+MIN_PX = 2  # a column holds a colour when it has this many of its pixels (half resolution): not one noisy pixel
+
+SideCounts = Tuple[int, int]  # landmark-like columns on the left and on the right
+
+
+def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> SideCounts:
+    """Columns (half resolution) of the frame's two side strips that hold red above blue, outside ``boxes``.
+
+    A column counts when it has at least ``MIN_PX`` red and ``MIN_PX`` blue class
+    pixels and its first red one lies above its last blue one, as in a landmark's
+    columns; a wall of one colour, or a robot's body in front of it, changes no count.
+
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        The full-resolution frame.
+    cfg : DetectionParams
+        Hue ranges and the S/V thresholds of the full scan.
+    gains : Gains
+        The balance the full scan classified with.
+    boxes : sequence of BBox
+        Full-resolution boxes of the landmarks already known (blanked).
+    """
+    w = bgr.shape[1]
+    s = min(EDGE_STRIP_PX, w // 4) // 2 * 2
+    if s < 2:
+        return (0, 0)
+    half = s // 2
+    strips = np.concatenate([bgr[::2, 0:s:2], bgr[::2, w - s : w : 2]], axis=1)
+    red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    for bx, by, bw, bh in boxes:
+        y0, y1 = max(0, by // 2), max(0, -(-(by + bh) // 2))
+        for x0, off in ((0, 0), (w - s, half)):  # the box's columns inside each strip
+            c0, c1 = max(bx, x0), min(bx + bw, x0 + s)
+            if c1 > c0 and y1 > y0:
+                cols = slice(off + (c0 - x0) // 2, off + -(-(c1 - x0) // 2))
+                red[y0:y1, cols] = 0
+                blue[y0:y1, cols] = 0
+    r, b = red > 0, blue > 0
+    top_red = np.argmax(r, axis=0)
+    last_blue = b.shape[0] - 1 - np.argmax(b[::-1], axis=0)
+    both = (r.sum(axis=0) >= MIN_PX) & (b.sum(axis=0) >= MIN_PX) & (top_red < last_blue)
+    return int(both[:half].sum()), int(both[half:].sum())
+
+
+def came_in(now: SideCounts, recorded: SideCounts) -> bool:
+    """Whether a side gained ``NEW_COLUMNS`` landmark-like columns since the counts a full scan recorded."""
+    return any(n >= r + NEW_COLUMNS for n, r in zip(now, recorded))
