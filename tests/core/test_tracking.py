@@ -152,3 +152,20 @@ def test_a_landmark_coming_out_from_behind_a_nearer_one_is_found_as_it_comes_out
     assert hidden and max(hidden) < len(frames) - 8  # hidden for a while, then out again for a full-scan cycle
     out = max(hidden) + 1
     assert all(b == a for a, b in counts[out + 1:])  # found at most a frame after a full scan sees it again
+
+
+def test_a_full_scan_hands_each_landmark_the_velocity_of_the_track_it_continues():
+    from rangebearing.core.detect import BandCentroids
+    from rangebearing.core.tracking import Track, rescanned
+
+    def bands(x: float, w: int = 20) -> BandCentroids:
+        return BandCentroids((x, 100.0), (x, 140.0), (int(x) - w // 2, 95, w, 10), (int(x) - w // 2, 135, w, 10),
+                             100.0, 100.0, 50.0, 50.0)
+
+    moving = Track(bands(200.0), (3.0, 0.0))  # 3 px a frame to the right
+    lost = Track(bands(400.0), (-2.0, 0.0))  # lost in the frame before the scan: two frames old
+    out = rescanned([moving], [bands(203.5), bands(396.0), bands(50.0), bands(206.0, 60)], [lost])
+    assert out[0].velocity_px == pytest.approx((3.5, 0.0))
+    assert out[1].velocity_px == pytest.approx((-2.0, 0.0))
+    assert out[2].velocity_px == (0.0, 0.0)  # a newcomer
+    assert out[3].velocity_px == (0.0, 0.0)  # three times as wide: another landmark
