@@ -8,9 +8,8 @@ observer turning). Each frame the two side strips are classified at the full
 scan's half resolution (a few small calls: two strips of ``EDGE_STRIP_PX``
 columns), the followed landmarks' boxes are blanked, and the columns left that
 hold red above blue, as a landmark's do, are counted. A full scan records the
-counts it leaves; when a side gains ``NEW_SHARE`` of as many as a landmark with
-those bands' height is wide, something like a landmark came in there, and the caller
-scans the whole frame.
+counts it leaves; when a side gains ``NEW_COLUMNS`` of them, something like a
+landmark came in there, and the caller scans the whole frame.
 
 A wall of one colour, or a robot's body passing in front of it, makes no such
 column. Red over blue things at the side only raise the counts the scan
@@ -31,17 +30,13 @@ from .types import BBox
 
 EDGE_STRIP_PX = 48  # full-resolution columns: 60 % of the nearest landmark's width (0.45 m) fits in
 NEW_COLUMNS = 2  # half-resolution columns: 60 % of a landmark at 2 m is about 3
-NEW_SHARE = 0.3  # of a landmark's width come in since the last scan
-WIDTH_PER_BAND = 35 / 15  # a landmark is 35 mm across, its bands 15 mm tall
 MIN_PX = 2  # a column holds a colour when it has this many of its pixels (half resolution): not one noisy pixel
 
-# per side (left, right): landmark-like columns, and the width (columns) of a landmark with their bands' height
-SideCounts = Tuple[Tuple[int, float], Tuple[int, float]]
+SideCounts = Tuple[int, int]  # landmark-like columns on the left and on the right
 
 
 def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> SideCounts:
-    """Columns (half resolution) of the frame's two side strips that hold red above blue, outside ``boxes``,
-    and the width of a landmark whose bands are as tall as their red (the median column's).
+    """Columns (half resolution) of the frame's two side strips that hold red above blue, outside ``boxes``.
 
     A column counts when it has at least ``MIN_PX`` red and ``MIN_PX`` blue class
     pixels and its first red one lies above its last blue one, as in a landmark's
@@ -61,7 +56,7 @@ def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequ
     w = bgr.shape[1]
     s = min(EDGE_STRIP_PX, w // 4) // 2 * 2
     if s < 2:
-        return ((0, 0.0), (0, 0.0))
+        return (0, 0)
     half = s // 2
     strips = np.concatenate([bgr[::2, 0:s:2], bgr[::2, w - s : w : 2]], axis=1)
     red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
@@ -74,28 +69,12 @@ def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequ
                 red[y0:y1, cols] = 0
                 blue[y0:y1, cols] = 0
     r, b = red > 0, blue > 0
-    n_red = np.count_nonzero(r, axis=0)
     top_red = np.argmax(r, axis=0)
     last_blue = b.shape[0] - 1 - np.argmax(b[::-1], axis=0)
-    both = (n_red >= MIN_PX) & (np.count_nonzero(b, axis=0) >= MIN_PX) & (top_red < last_blue)
-    out = []
-    for cols in (slice(0, half), slice(half, None)):
-        k = int(both[cols].sum())
-        band = float(np.median(n_red[cols][both[cols]])) if k else 0.0
-        out.append((k, band * WIDTH_PER_BAND))
-    return out[0], out[1]
+    both = (r.sum(axis=0) >= MIN_PX) & (b.sum(axis=0) >= MIN_PX) & (top_red < last_blue)
+    return int(both[:half].sum()), int(both[half:].sum())
 
 
 def came_in(now: SideCounts, recorded: SideCounts) -> bool:
-    """Whether a side gained, since the counts a full scan recorded, ``NEW_SHARE`` of the columns of a
-    landmark of its bands' height (at least ``NEW_COLUMNS``, at most what the strip has left).
-
-    A landmark is findable from 60 % in view: coming in, it is scanned for at
-    about 30, 60 and 90 %, not at every column it adds.
-    """
-    half = EDGE_STRIP_PX // 2
-    for (n, width), (r, _) in zip(now, recorded):
-        need = max(NEW_COLUMNS, min(NEW_SHARE * width, half - r - 1))
-        if n - r >= need:
-            return True
-    return False
+    """Whether a side gained ``NEW_COLUMNS`` landmark-like columns since the counts a full scan recorded."""
+    return any(n >= r + NEW_COLUMNS for n, r in zip(now, recorded))

@@ -93,7 +93,7 @@ class Pipeline:
         self._lost: List[Track] = []  # tracks the last (tracked) frame lost
         self._hidden: List[Hidden] = []
         self._since_scan = 0
-        self._sides: SideCounts = ((0, 0.0), (0, 0.0))
+        self._sides: SideCounts = (0, 0)
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
 
