@@ -36,18 +36,11 @@ def test_a_known_landmark_is_blanked_and_walls_of_one_colour_count_nothing():
     paint_landmark(img, 0, 10)
     assert side_colour(img, DetectionParams(), UNIT, [(0, 15, 12, 60)]) == (0, 0)
     wall = frame()
-    wall[:, :, :] = BLUE  # a blue wall, then a red one: neither is red above blue
+    wall[:, :, :] = BLUE  # a blue wall, then a red one: neither holds both colours
     assert side_colour(wall, DetectionParams(), UNIT, []) == (0, 0)
     wall[:60] = RED
     wall[60:] = GREY
     assert side_colour(wall, DetectionParams(), UNIT, []) == (0, 0)
-
-
-def test_blue_above_red_is_no_landmark_column():
-    img = frame()
-    img[20:30, 0:10] = BLUE
-    img[60:70, 0:10] = RED
-    assert side_colour(img, DetectionParams(), UNIT, []) == (0, 0)
 
 
 def test_only_growth_past_the_recorded_counts_is_a_newcomer():

@@ -7,12 +7,12 @@ come into view at the frame's left and right sides (a neighbour driving in, the
 observer turning). Each frame the two side strips are classified at the full
 scan's half resolution (a few small calls: two strips of ``EDGE_STRIP_PX``
 columns), the followed landmarks' boxes are blanked, and the columns left that
-hold red above blue, as a landmark's do, are counted. A full scan records the
+hold both red and blue, as a landmark's do, are counted. A full scan records the
 counts it leaves; when a side gains ``NEW_COLUMNS`` of them, something like a
 landmark came in there, and the caller scans the whole frame.
 
 A wall of one colour, or a robot's body passing in front of it, makes no such
-column. Red over blue things at the side only raise the counts the scan
+column. Red and blue things at the side only raise the counts the scan
 records; they trigger nothing until they change. A landmark not yet findable
 when the scan runs is in the recorded counts, and triggers the next scan by
 growing further as it comes in.
@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from typing import Sequence, Tuple
 
+import cv2
 import numpy as np
 
 from .color import Gains, apply_gains, class_masks, to_hsv
@@ -36,11 +37,11 @@ SideCounts = Tuple[int, int]  # landmark-like columns on the left and on the rig
 
 
 def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> SideCounts:
-    """Columns (half resolution) of the frame's two side strips that hold red above blue, outside ``boxes``.
+    """Columns (half resolution) of the frame's two side strips that hold both band colours, outside ``boxes``.
 
     A column counts when it has at least ``MIN_PX`` red and ``MIN_PX`` blue class
-    pixels and its first red one lies above its last blue one, as in a landmark's
-    columns; a wall of one colour, or a robot's body in front of it, changes no count.
+    pixels, as a landmark's columns do; a wall of one colour, or a robot's body
+    in front of it, changes no count.
 
     Parameters
     ----------
@@ -53,12 +54,14 @@ def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequ
     boxes : sequence of BBox
         Full-resolution boxes of the landmarks already known (blanked).
     """
-    w = bgr.shape[1]
+    h, w = bgr.shape[:2]
     s = min(EDGE_STRIP_PX, w // 4) // 2 * 2
-    if s < 2:
+    if s < 2 or h < 2:
         return (0, 0)
     half = s // 2
-    strips = np.concatenate([bgr[::2, 0:s:2], bgr[::2, w - s : w : 2]], axis=1)
+    size = (half, h // 2)  # every other pixel of each strip: the full scan's resolution
+    strips = cv2.hconcat([cv2.resize(bgr[:, :s], size, interpolation=cv2.INTER_NEAREST),
+                          cv2.resize(bgr[:, w - s :], size, interpolation=cv2.INTER_NEAREST)])
     red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
     for bx, by, bw, bh in boxes:
         y0, y1 = max(0, by // 2), max(0, -(-(by + bh) // 2))
@@ -68,11 +71,10 @@ def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequ
                 cols = slice(off + (c0 - x0) // 2, off + -(-(c1 - x0) // 2))
                 red[y0:y1, cols] = 0
                 blue[y0:y1, cols] = 0
-    r, b = red > 0, blue > 0
-    top_red = np.argmax(r, axis=0)
-    last_blue = b.shape[0] - 1 - np.argmax(b[::-1], axis=0)
-    both = (r.sum(axis=0) >= MIN_PX) & (b.sum(axis=0) >= MIN_PX) & (top_red < last_blue)
-    return int(both[:half].sum()), int(both[half:].sum())
+    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    both = (n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX)
+    return int(np.count_nonzero(both[:half])), int(np.count_nonzero(both[half:]))
 
 
 def came_in(now: SideCounts, recorded: SideCounts) -> bool:
