@@ -156,7 +156,8 @@ def test_a_landmark_coming_out_from_behind_a_nearer_one_is_found_as_it_comes_out
 
 def test_a_full_scan_hands_each_landmark_the_velocity_of_the_track_it_continues():
     from rangebearing.core.detect import BandCentroids
-    from rangebearing.core.tracking import Track, rescanned
+    from rangebearing.core.scans import rescanned
+    from rangebearing.core.tracking import Track
 
     def bands(x: float, w: int = 20) -> BandCentroids:
         return BandCentroids((x, 100.0), (x, 140.0), (int(x) - w // 2, 95, w, 10), (int(x) - w // 2, 135, w, 10),

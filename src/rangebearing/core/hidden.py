@@ -6,7 +6,7 @@ comes out again it would stay unreported until the next scheduled full scan.
 A landmark that vanishes where a found landmark now stands is therefore kept
 here, where it was last seen, for up to ``full_scan_every`` frames: while a
 tracked landmark covers that place, the pipeline scans the whole frame
-(:func:`.tracking.crossing` over tracks and hidden ones), and the first scan
+(:func:`.scans.crossing` over tracks and hidden ones), and the first scan
 that sees it again makes it a track.
 """
 
@@ -16,7 +16,8 @@ from typing import List, Sequence, Tuple
 
 from .._compat import frozen
 from .detect import BandCentroids
-from .tracking import Track, crossing
+from .scans import crossing
+from .tracking import Track
 
 WIDTH_RATIO = 1.6  # a landmark found again: about as wide as it was
 

@@ -30,8 +30,9 @@ from .newcomers import SideCounts, came_in, side_colour
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
+from .scans import crossing, rescanned
 from .structure import Candidate
-from .tracking import Track, crossing, rescanned, step
+from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import chroma_blur_px, reading_sigma
 from .verify import verified

@@ -32,7 +32,6 @@ from .structure import Candidate
 from .types import XY, BBox, LandmarkGeometry
 
 MASS_RATIO = (0.6, 1.6)  # a band's weight may change this much between frames
-WIDTH_RATIO = 1.6  # a landmark found again by a full scan: about as wide as it was
 ON_TARGET_PX = 1.5  # a band measured this close to its predicted place was whole inside its tight window
 
 
@@ -67,41 +66,6 @@ def _origin(t: Track) -> Tuple[XY, XY]:
     return b.moments_px if b.moments_px is not None else (b.red_xy_px, b.blue_xy_px)
 
 
-def rescanned(before: Sequence[Track], found: Sequence[BandCentroids], lost: Sequence[Track] = ()) -> List[Track]:
-    """Tracks for a full scan's landmarks, each moving as the track it continues moved (a newcomer stands still).
-
-    ``before`` are the tracks of the last frame, ``lost`` those the frame before
-    it lost (a track lost in a window is scanned for the next frame). The
-    landmark a track continues is the one nearest its predicted place, within
-    half a width of it and about as wide; its velocity is its step since the
-    track was last measured. Started from rest, a moving landmark's first
-    windows would lag it by its speed.
-    """
-    known = [(t, 1) for t in before] + [(t, 2) for t in lost]
-    out, used = [], set()
-    for c in found:
-        cx, cy = _middle(c)
-        best, gap = None, 0.5 * c.width_px
-        for k, (t, age) in enumerate(known):
-            tx, ty = _middle(t.bands)
-            d = max(abs(tx + age * t.velocity_px[0] - cx), abs(ty + age * t.velocity_px[1] - cy))
-            ratio = c.width_px / max(t.bands.width_px, 1e-6)
-            if k not in used and d <= gap and 1 / WIDTH_RATIO <= ratio <= WIDTH_RATIO:
-                best, gap = k, d
-        if best is None:
-            out.append(Track(c))
-            continue
-        used.add(best)
-        t, age = known[best]
-        tx, ty = _middle(t.bands)
-        out.append(Track(c, ((cx - tx) / age, (cy - ty) / age)))
-    return out
-
-
-def _middle(c: BandCentroids) -> XY:
-    return 0.5 * (c.red_xy_px[0] + c.blue_xy_px[0]), 0.5 * (c.red_xy_px[1] + c.blue_xy_px[1])
-
-
 def _moved(box: BBox, dx: float, dy: float) -> BBox:
     return (round(box[0] + dx), round(box[1] + dy), box[2], box[3])
 
@@ -115,28 +79,6 @@ def search_boxes(track: Track) -> Tuple[BBox, BBox]:
     """The red and blue boxes moved by the track's velocity."""
     vx, vy = track.velocity_px
     return _moved(track.bands.red_bbox_px, vx, vy), _moved(track.bands.blue_bbox_px, vx, vy)
-
-
-def crossing(tracks: Sequence[Track], slack_px: float = 2.0) -> bool:
-    """Whether two landmarks may overlap in the image this frame: their predicted columns meet.
-
-    Each landmark's columns are its bands' boxes moved by its velocity and grown
-    by its speed and ``slack_px``. Where two meet, one passes in front of the
-    other: windows then hold parts of both (a track slides onto its neighbour or
-    measures the merged pair), and the one behind is partly hidden in a way
-    that only a full scan measures (or that ends a robot's occlusion). The
-    caller scans the whole frame instead.
-    """
-    if len(tracks) < 2:
-        return False
-    spans = []
-    for t in tracks:
-        red, blue = search_boxes(t)
-        grow = abs(t.velocity_px[0]) + slack_px
-        spans.append((min(red[0], blue[0]) - grow, max(red[0] + red[2], blue[0] + blue[2]) + grow))
-    spans.sort()
-    ends = np.maximum.accumulate([end for _, end in spans])
-    return any(start < end for (start, _), end in zip(spans[1:], ends[:-1]))
 
 
 def plausible(old: BandCentroids, red: BandFix, blue: BandFix, geometry: LandmarkGeometry, lim: PairingLimits) -> bool:
