@@ -56,6 +56,8 @@ class BandCentroids:
     candidate: Optional[Candidate] = None  # what the structure search found (tracking measures it again)
     #: the bands' moments (red, blue) in their boxes, before the edges' rows are combined in (tracking predicts them)
     moments_px: Optional[Tuple[XY, XY]] = None
+    #: the colour's own blur (:func:`.uncertainty.chroma_blur_px`) when already measured (tracking keeps a scan's)
+    chroma_blur_px: Optional[float] = None
 
     @property
     def width_px(self) -> float:

@@ -14,6 +14,7 @@ a full scan or in tracking windows).
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Dict, List, Optional, Tuple
 
 import numpy as np
@@ -170,6 +171,10 @@ class Pipeline:
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
+                if self.track:  # the colour's blur, measured once here and kept by the tracked frames after it
+                    found = [dataclasses.replace(c, chroma_blur_px=chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px,
+                                                                                  c.width_px, self._gains))
+                             for c in found]
                 if self.track:
                     self._hidden = still_hidden([*self._tracks, *self._lost], self._hidden, found, det.full_scan_every)
                 self._tracks = rescanned(self._tracks, found, self._lost) if self.track else []
@@ -202,7 +207,9 @@ class Pipeline:
         c_m = model.c_m if model.kind == "pinhole" else 0.0
         width_px = c.width_px
         cut = cut_sides(c.candidate, bgr.shape[1]) if c.candidate is not None else (False, False)
-        blur_px = chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px, width_px, self._gains)
+        blur_px = c.chroma_blur_px
+        if blur_px is None:
+            blur_px = chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px, width_px, self._gains)
         s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px,
                                  c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut, blur_px)
         return (rng, bearing, d_v, d_h, l_px, c.red_xy_px, c.blue_xy_px, width_px, c.bbox_px,

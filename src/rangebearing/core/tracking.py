@@ -183,6 +183,8 @@ def step(
             now: Optional[BandCentroids] = _moved_only(t.bands, _origin(t), red, blue)
         else:
             now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, _noise(row_of[k], t.bands, cand))
+            if now is not None and t.bands.chroma_blur_px is not None:  # the camera's, as the last full scan saw it
+                now = dataclasses.replace(now, chroma_blur_px=t.bands.chroma_blur_px)
         if now is None:
             continue
         kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
