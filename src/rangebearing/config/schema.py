@@ -154,6 +154,9 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "cylinder_correction": ck.boolean,
             "envelope_range_m": ck.pair(0, 100),
             "envelope_bearing_rad": ck.pair(-math.pi, math.pi),
+            "centre_below_m": ck.number(-1, 1),
+            "horizon_y_n": ck.number(-1, 1),
+            "centre_sigma_m": ck.number(0, 1),
         },
     ),
     "identity": (

@@ -17,6 +17,8 @@ from .params import ModelParams
 
 MIN_SAMPLES = 4
 MIN_RANGE_SPREAD = 1.15  # farthest / nearest true range
+# the landmarks' height in the image is fitted only when it is one height: robots alike on one floor
+MAX_CENTRE_SIGMA_M = 0.012
 
 
 @frozen
@@ -30,6 +32,7 @@ class Sample:
     px_left: float  # horizontal offset of the centroids from the principal point, + left
     range_m: float
     bearing_rad: float
+    y_norm: float = math.nan  # normalised image row of the band centroids' midpoint (+ down)
 
 
 @frozen
@@ -116,9 +119,40 @@ def fit_model(samples: Sequence[Sample], base: ModelParams) -> Fit:
         )
         f_rng = spacing * x + c
         f_th = th_m
+    model = dataclasses.replace(model, **centre_height(samples, model.spacing_m))
     residuals = tuple(
         Residual(s.frame, s.range_m, float(fr), s.bearing_rad, float(fb)) for s, fr, fb in zip(samples, f_rng, f_th)
     )
     r_err = np.abs([r.range_err_pct for r in residuals])
     b_err = np.abs([r.bearing_err_deg for r in residuals])
     return Fit(model, residuals, float(r_err.mean()), float(r_err.max()), float(b_err.mean()))
+
+
+def centre_height(samples: Sequence[Sample], spacing_m: float) -> dict:
+    """``centre_below_m``, ``horizon_y_n`` and ``centre_sigma_m`` of the landmarks in the samples.
+
+    A landmark centre ``Y`` below the camera, at depth ``Z``, images at the normalised row
+    ``y_n = Y/Z + t`` (``t``: tan of the camera's pitch, the horizon's row); with
+    ``Z = spacing/L_n`` that is ``y_n = t + (Y/spacing)·L_n``, a line in ``L_n``. Fitted by
+    least squares, once more without the samples beyond 3 σ (a mismatched detection). When
+    there are too few samples, or the heights spread more than :data:`MAX_CENTRE_SIGMA_M`
+    (landmarks at different heights), ``centre_sigma_m`` is 0: no height is known.
+    """
+    keep = [s for s in samples if s.y_norm == s.y_norm]
+    off = {"centre_below_m": 0.0, "horizon_y_n": 0.0, "centre_sigma_m": 0.0}
+    if len(keep) < 2 * MIN_SAMPLES:
+        return off
+    ln = np.array([s.l_norm for s in keep])
+    yn = np.array([s.y_norm for s in keep])
+    use = np.ones(len(ln), bool)
+    for _ in range(2):
+        if use.sum() < 2 * MIN_SAMPLES or np.ptp(ln[use]) <= 0:
+            return off
+        a = np.column_stack((np.ones(int(use.sum())), ln[use]))
+        (t, k), *_ = np.linalg.lstsq(a, yn[use], rcond=None)
+        dev_m = (yn - t - k * ln) * spacing_m / ln  # each landmark's height off the fit, metres
+        sigma = float(np.sqrt(np.mean(dev_m[use] ** 2)))
+        use = np.abs(dev_m) <= max(3.0 * sigma, 1e-4)
+    if not sigma <= MAX_CENTRE_SIGMA_M:
+        return off
+    return {"centre_below_m": float(k * spacing_m), "horizon_y_n": float(t), "centre_sigma_m": max(sigma, 1e-4)}

@@ -57,6 +57,10 @@ class ModelParams:
     cylinder_correction: bool = True
     envelope_range_m: Tuple[float, float] = (0.15, 2.0)
     envelope_bearing_rad: Tuple[float, float] = (-0.45, 0.45)
+    # where landmarks stand in the image (calibrate fits them; see core/verify.py's height check):
+    centre_below_m: float = 0.0  # a landmark's centre below the camera's optical centre, metres
+    horizon_y_n: float = 0.0  # normalised image row of the horizon (tan of the camera's pitch, + down)
+    centre_sigma_m: float = 0.0  # spread of the centre's height over the calibration landmarks; 0: not fitted
 
 
 @frozen

@@ -169,7 +169,8 @@ class Pipeline:
                     cands = find(self._gains)
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
-                found = verified(bgr, found, self.params.landmark)  # no landmark without a landmark's properties
+                # no landmark without a landmark's properties, nor away from where landmarks stand
+                found = verified(bgr, found, self.params.landmark, self.params.model, cam)
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
                 if self.track:  # the colour's blur, measured once here and kept by the tracked frames after it
                     found = [dataclasses.replace(c, chroma_blur_px=chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px,

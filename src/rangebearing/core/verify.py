@@ -6,12 +6,25 @@ grey wall over a navy mat, a robot's dark chassis between a red box and a blue
 one, a neighbour's mast-mounted camera under a band. What they lack, and what
 the checks here ask for:
 
-- **Its own band edges.** A band whose colour runs on past its outer edge
-  (``red_merged``/``blue_merged``: a wall, box or mat of its colour behind it)
-  is placed from its inner edge and the white height. When *both* bands merge,
-  nothing of the candidate is the landmark's own shape: only two colour steps
-  with something light between, which any red surface over a light strip over a
-  blue one shows. Such a candidate is no landmark.
+- **Its place in the image.** Every robot carries its landmark at one height on
+  one floor, so a landmark's centre lies a fixed height ``Y`` below the camera:
+  at depth ``Z = S/L_n`` it images at the normalised row ``t + Y/Z`` (``t`` the
+  horizon's row, the camera's pitch). ``calibrate`` fits ``Y``, ``t`` and their
+  spread (``ModelParams.centre_below_m``, ``horizon_y_n``, ``centre_sigma_m``).
+  A red–white–blue stack of other things has its own height: a wall's foot over
+  the floor over a robot's blue top plate lies wholly below the horizon, its
+  "landmark" a few centimetres lower than a landmark of its size can be. A
+  candidate whose centre is more than :func:`height_tolerance_m` off is no
+  landmark. The check reads only the two band rows and the calibration, so it
+  holds in any light, against any background.
+- **Its own band edges, when no height is fitted.** A band whose colour runs on
+  past its outer edge (``red_merged``/``blue_merged``: a wall, box or mat of its
+  colour behind it) is placed from its inner edge and the white height. When
+  *both* bands merge, red over light over blue is all that is left, which any
+  red surface over a light strip over a blue one shows too. Without a fitted
+  height such a candidate is no landmark; with one, it must stand where a
+  landmark of its size stands (a real landmark before a red wall and a blue mat
+  does, the wall's foot over the floor does not).
 - **A white body lighter than either band in the band's own channel.** White
   paint reflects more of every channel than the red or blue paint does (ours:
   red channel 0.85 against the red paint's 0.70, blue 0.85 against 0.65). The
@@ -37,11 +50,17 @@ import numpy as np
 
 from .detect import BandCentroids
 from .edges import linear_table
-from .types import LandmarkGeometry
+from .model import normalised
+from .params import ModelParams
+from .types import CameraIntrinsics, LandmarkGeometry
 
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
 SAMPLES = 24  # rows and columns sampled per region, at most
+# height check: the tolerance is at least this, or 3 fitted sigmas ...
+HEIGHT_MIN_TOL_M = 0.015
+# ... plus the camera rocking (tan 0.5 deg) times the depth: a robot tilts on its wheels
+PITCH_WOBBLE = 0.0087
 
 
 def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float], channel: int, pct: float) -> float:
@@ -75,7 +94,21 @@ def percentile(values: np.ndarray, pct: float, table: Optional[np.ndarray] = Non
     return high - (high - low) * (1.0 - t) if t >= 0.5 else low + (high - low) * t
 
 
-def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry) -> Optional[str]:
+def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
+    """How far (m) a landmark's centre at ``depth_m`` may lie from the fitted height."""
+    return max(HEIGHT_MIN_TOL_M, 3.0 * model.centre_sigma_m) + PITCH_WOBBLE * depth_m
+
+
+def height_off_m(c: BandCentroids, model: ModelParams, cam: CameraIntrinsics) -> Tuple[float, float]:
+    """``(off_m, depth_m)``: how far the candidate's centre lies below the fitted landmark height, and its depth."""
+    (xr, yr), (xb, yb) = normalised(np.array([c.red_xy_px, c.blue_xy_px]), cam)
+    l_n = float(np.hypot(xb - xr, yb - yr))
+    depth = model.spacing_m / max(l_n, 1e-9)
+    return (0.5 * (yr + yb) - model.horizon_y_n) * depth - model.centre_below_m, depth
+
+
+def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, model: Optional[ModelParams] = None,
+              cam: Optional[CameraIntrinsics] = None) -> Optional[str]:
     """Why ``c`` is no landmark, or ``None`` when it passes every check (see the module docstring).
 
     Parameters
@@ -86,9 +119,16 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry) -> 
         The measured candidate (its band rows and visible columns).
     geometry : LandmarkGeometry
         The landmark's dimensions (band and white heights from the band spacing).
+    model, cam : ModelParams, CameraIntrinsics, optional
+        The calibration and the frame's intrinsics: with a fitted height
+        (``model.centre_sigma_m > 0``) the candidate must stand at it.
     """
     cand = c.candidate
-    if cand is not None and cand.red_merged and cand.blue_merged:
+    if model is not None and cam is not None and model.centre_sigma_m > 0:
+        off, depth = height_off_m(c, model, cam)
+        if abs(off) > height_tolerance_m(depth, model):
+            return f"its centre is {100 * off:+.1f} cm off the height where landmarks stand"
+    elif cand is not None and cand.red_merged and cand.blue_merged:
         return "both bands merge with their backgrounds: no edge of the landmark's own"
     ry, by = c.red_xy_px[1], c.blue_xy_px[1]
     spacing = by - ry
@@ -108,6 +148,7 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry) -> 
     return None
 
 
-def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry) -> List[BandCentroids]:
+def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry,
+             model: Optional[ModelParams] = None, cam: Optional[CameraIntrinsics] = None) -> List[BandCentroids]:
     """The candidates that pass every check of :func:`rejection`, in their order."""
-    return [c for c in found if rejection(bgr, c, geometry) is None]
+    return [c for c in found if rejection(bgr, c, geometry, model, cam) is None]

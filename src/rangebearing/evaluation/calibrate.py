@@ -15,6 +15,7 @@ import numpy as np
 from ..config import Config
 from ..core.fit import Fit, Sample, fit_model
 from ..core.focal_check import FocalCheck, check_focal
+from ..core.model import normalised
 from ..core.pipeline import Pipeline
 from .match import match_frame
 from .truth import TruthRow
@@ -44,7 +45,9 @@ def collect_samples(frames: Frames, cfg: Config) -> List[Sample]:
             lm = m.found
             px_left = cam.cx_px - 0.5 * (lm.red_xy_px[0] + lm.blue_xy_px[0])
             l_norm = lm.l_px / cam.fy_px
-            samples.append(Sample(name, lm.l_px, l_norm, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad))
+            y_norm = float(normalised(np.array([lm.red_xy_px, lm.blue_xy_px]), cam)[:, 1].mean())
+            samples.append(Sample(name, lm.l_px, l_norm, lm.bearing_rad, px_left, m.truth.range_m, m.truth.bearing_rad,
+                                  y_norm))
     return samples
 
 
