@@ -1,6 +1,7 @@
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from rangebearing.core.fit import Sample, fit_model
@@ -52,3 +53,26 @@ def test_paper_fit_recovers_k_and_kh():
 def test_fit_refuses_data_that_cannot_support_it(samples, message):
     with pytest.raises(CalibrationError, match=message):
         fit_model(samples, ModelParams())
+
+
+def height_samples(centre_below_m, horizon_y_n, jitter_m=0.0, n=12):
+    """Pinhole samples whose band midpoints image a landmark centre ``centre_below_m`` under the camera."""
+    rng = np.random.default_rng(5)
+    out = []
+    for s in pinhole_samples(np.linspace(0.2, 1.4, n), np.zeros(n)):
+        depth = S / s.l_norm
+        y = horizon_y_n + (centre_below_m + jitter_m * rng.standard_normal()) / depth
+        out.append(dataclasses.replace(s, y_norm=y))
+    return out
+
+
+def test_calibration_fits_where_landmarks_stand_in_the_image():
+    fit = fit_model(height_samples(0.012, -0.035), ModelParams())  # 12 mm below the camera, pitched up 2 deg
+    assert fit.model.centre_below_m == pytest.approx(0.012, abs=1e-6)
+    assert fit.model.horizon_y_n == pytest.approx(-0.035, abs=1e-6)
+    assert 0 < fit.model.centre_sigma_m < 1e-3
+
+
+def test_no_height_is_fitted_from_landmarks_at_different_heights_or_without_rows():
+    assert fit_model(height_samples(0.0, 0.0, jitter_m=0.03), ModelParams()).model.centre_sigma_m == 0.0
+    assert fit_model(pinhole_samples([0.2, 0.4, 0.7, 1.1, 1.6], [0.0] * 5), ModelParams()).model.centre_sigma_m == 0

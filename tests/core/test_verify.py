@@ -1,11 +1,14 @@
 """False-landmark checks (core/verify.py): hand-made frames whose answer follows from the paints."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from rangebearing.core.detect import BandCentroids
+from rangebearing.core.params import ModelParams
 from rangebearing.core.structure import Candidate
-from rangebearing.core.types import LandmarkGeometry
+from rangebearing.core.types import CameraIntrinsics, LandmarkGeometry
 from rangebearing.core.verify import percentile, rejection
 
 GEOMETRY = LandmarkGeometry()
@@ -82,3 +85,31 @@ def test_percentile_through_a_table_is_the_percentile_of_the_looked_up_values():
         v = rng.integers(0, 256, (n,)).astype(np.uint8)
         for pct in (0, 50, 75, 90, 100):
             assert percentile(v, pct, table) == percentile(table[v], pct)  # the same value, bit for bit
+
+
+# the test frame at 1 px/mm: band spacing 55 px = the 0.055 m spacing at depth f = 55 px / L_n, with f = 100 px
+CAM = CameraIntrinsics(fx_px=100.0, fy_px=100.0, cx_px=40.0, cy_px=54.5)  # the landmark's centre row is 54.5
+FITTED = dataclasses.replace(ModelParams(), spacing_m=0.055, centre_sigma_m=0.004)
+
+
+@pytest.mark.parametrize("centre_below_m, rejected", [(0.0, False), (0.012, False), (-0.012, False),
+                                                        (0.04, True), (-0.04, True)])
+def test_a_candidate_must_stand_at_the_fitted_height(centre_below_m, rejected):
+    # the candidate's centre is on the optical axis (depth 0.1 m here); landmarks stand centre_below_m lower
+    model = dataclasses.replace(FITTED, centre_below_m=centre_below_m)
+    why = rejection(frame(), found(), GEOMETRY, model, CAM)
+    assert (why is not None and "height" in why) == rejected
+
+
+def test_the_horizon_moves_with_the_cameras_pitch():
+    model = dataclasses.replace(FITTED, horizon_y_n=0.4)  # pitched: the horizon 40 px below the centre row
+    assert "height" in rejection(frame(), found(), GEOMETRY, model, CAM)
+    model = dataclasses.replace(model, centre_below_m=-0.04)  # ... where a landmark 4 cm over the camera is
+    assert rejection(frame(), found(), GEOMETRY, model, CAM) is None
+
+
+def test_with_a_fitted_height_two_merged_bands_at_it_are_a_landmark():
+    # a landmark before a red wall over a blue mat: both bands merge, it stands where landmarks stand
+    assert rejection(frame(), found(red_merged=True, blue_merged=True), GEOMETRY, FITTED, CAM) is None
+    unfitted = dataclasses.replace(FITTED, centre_sigma_m=0.0)
+    assert "both bands" in rejection(frame(), found(red_merged=True, blue_merged=True), GEOMETRY, unfitted, CAM)
