@@ -58,7 +58,7 @@ BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white 
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
 SAMPLES = 24  # rows and columns sampled per region, at most
 # height check: the tolerance is at least this, or 3 fitted sigmas ...
-HEIGHT_MIN_TOL_M = 0.015
+HEIGHT_MIN_TOL_M = 0.03
 # ... plus the camera rocking (tan 0.5 deg) times the depth: a robot tilts on its wheels
 PITCH_WOBBLE = 0.0087
 
