@@ -113,3 +113,25 @@ def test_with_a_fitted_height_two_merged_bands_at_it_are_a_landmark():
     assert rejection(frame(), found(red_merged=True, blue_merged=True), GEOMETRY, FITTED, CAM) is None
     unfitted = dataclasses.replace(FITTED, centre_sigma_m=0.0)
     assert "both bands" in rejection(frame(), found(red_merged=True, blue_merged=True), GEOMETRY, unfitted, CAM)
+
+
+def striped_frame():
+    """The red and white of the landmark run on across the whole frame (a skirting board under a red wall)."""
+    img = frame()
+    img[RED_ROWS[0] : RED_ROWS[1], :] = img[RED_ROWS[0], X0]
+    img[BODY_ROWS[0] : BODY_ROWS[1], :] = img[BODY_ROWS[0], X0]
+    return img
+
+
+def test_red_and_white_running_on_beyond_both_sides_are_stripes_not_a_landmark():
+    assert "stripes" in rejection(striped_frame(), found(), GEOMETRY)
+    one_side = striped_frame()
+    one_side[:, X1 + 2 :] = frame()[:, X1 + 2 :]  # beyond the right side the wall is grey: an object's side
+    assert rejection(one_side, found(), GEOMETRY) is None
+
+
+def test_a_touching_neighbour_beside_it_is_no_stripe():
+    c = found()
+    right = dataclasses.replace(c, red_bbox_px=(X1, *c.red_bbox_px[1:]), blue_bbox_px=(X1, *c.blue_bbox_px[1:]))
+    left = dataclasses.replace(c, red_bbox_px=(0, *c.red_bbox_px[1:]), blue_bbox_px=(0, *c.blue_bbox_px[1:]))
+    assert rejection(striped_frame(), c, GEOMETRY, others=[c, left, right]) is None

@@ -37,6 +37,15 @@ the checks here ask for:
   body (a neighbour's mast or camera in front of it darkens only part) and the
   upper quartile of each band's core.
 
+- **An object, not stripes.** A white skirting board between an orange wall and
+  a blue mat reads red → white → blue in every column along the wall; where
+  something in front of the mat ends the blue for a while, the structure finds
+  a "landmark" there. A landmark is an object: beside it, at the rows of its red
+  band and of its white body, lies something else (a background, a wall), not
+  both of its own colours again. A candidate whose band and body colours both
+  run on, unchanged, beyond both of its sides (and no other candidate stands
+  there: touching neighbours show their own bands and bodies) is no landmark.
+
 Levels are taken in linear light over the middle three fifths of the
 candidate's visible columns (limbs darken and mix with the background). Each
 check compares one channel with itself, so the white balance cancels.
@@ -61,6 +70,9 @@ SAMPLES = 24  # rows and columns sampled per region, at most
 HEIGHT_MIN_TOL_M = 0.03
 # ... plus the camera rocking (tan 0.5 deg) times the depth: a robot tilts on its wheels
 PITCH_WOBBLE = 0.0087
+# stripes: the colour beside the candidate, 0.15-0.6 of its width out, matches its own within this (log, per channel)
+SIDE_REACH = (0.15, 0.6)
+SAME_COLOUR_LOG = 0.25
 
 
 def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float], channel: int, pct: float) -> float:
@@ -72,6 +84,40 @@ def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]
         return float("nan")
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
     return percentile(bgr[r0:r1:rs, c0:c1:cs, channel], pct, linear_table())
+
+
+def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[np.ndarray]:
+    """Median linear RGB (B, G, R order) over a region of the frame, ``None`` when it is empty."""
+    h, w = bgr.shape[:2]
+    r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
+    c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
+    if r1 <= r0 or c1 <= c0:
+        return None
+    rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
+    px, table = bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), linear_table()
+    return np.array([percentile(px[:, k], 50, table) for k in range(3)])
+
+
+def _same(a: Optional[np.ndarray], b: Optional[np.ndarray]) -> bool:
+    return a is not None and b is not None and bool(np.all(np.abs(np.log((a + 0.01) / (b + 0.01))) <= SAME_COLOUR_LOG))
+
+
+def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, float]],
+            others: Sequence[BandCentroids] = ()) -> bool:
+    """Whether the colours of ``layers`` (row spans) run on unchanged beyond both sides of ``c``.
+
+    A side where another candidate's box reaches into the sampled strip does not count as
+    running on (a touching neighbour shows its own bands and body there).
+    """
+    x, _, w, _ = c.bbox_px
+    own = [_colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w)) for rows in layers]
+    near, far = SIDE_REACH[0] * w, SIDE_REACH[1] * w
+    for lo, hi in ((x - far, x - near), (x + w + near, x + w + far)):
+        if any(o is not c and o.bbox_px[0] < hi and o.bbox_px[0] + o.bbox_px[2] > lo for o in others):
+            return False
+        if not all(_same(o, _colour(bgr, rows, (lo, hi))) for o, rows in zip(own, layers)):
+            return False
+    return True
 
 
 def percentile(values: np.ndarray, pct: float, table: Optional[np.ndarray] = None) -> float:
@@ -108,7 +154,7 @@ def height_off_m(c: BandCentroids, model: ModelParams, cam: CameraIntrinsics) ->
 
 
 def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, model: Optional[ModelParams] = None,
-              cam: Optional[CameraIntrinsics] = None) -> Optional[str]:
+              cam: Optional[CameraIntrinsics] = None, others: Sequence[BandCentroids] = ()) -> Optional[str]:
     """Why ``c`` is no landmark, or ``None`` when it passes every check (see the module docstring).
 
     Parameters
@@ -122,6 +168,8 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     model, cam : ModelParams, CameraIntrinsics, optional
         The calibration and the frame's intrinsics: with a fitted height
         (``model.centre_sigma_m > 0``) the candidate must stand at it.
+    others : sequence of BandCentroids
+        The frame's other candidates (touching neighbours are no stripes).
     """
     cand = c.candidate
     if model is not None and cam is not None and model.centre_sigma_m > 0:
@@ -145,10 +193,12 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     white_b = _level(bgr, body, cols, 0, WHITE_PCT)
     if red_r > BAND_OVER_WHITE * white_r or blue_b > BAND_OVER_WHITE * white_b:
         return "the white body is darker than a band in the band's own channel"
+    if striped(bgr, c, ((ry - 0.25 * band, ry + 0.25 * band), body), others):
+        return "its red band and white body run on beyond both sides: stripes, not an object"
     return None
 
 
 def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry,
              model: Optional[ModelParams] = None, cam: Optional[CameraIntrinsics] = None) -> List[BandCentroids]:
     """The candidates that pass every check of :func:`rejection`, in their order."""
-    return [c for c in found if rejection(bgr, c, geometry, model, cam) is None]
+    return [c for c in found if rejection(bgr, c, geometry, model, cam, found) is None]
