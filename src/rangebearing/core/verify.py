@@ -53,6 +53,7 @@ check compares one channel with itself, so the white balance cancels.
 
 from __future__ import annotations
 
+import math
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -87,15 +88,14 @@ def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]
 
 
 def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[np.ndarray]:
-    """Median linear RGB (B, G, R order) over a region of the frame, ``None`` when it is empty."""
+    """Linear RGB (B, G, R order) of a region's mean 8-bit colour, ``None`` when the region is empty."""
     h, w = bgr.shape[:2]
     r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
     c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
     if r1 <= r0 or c1 <= c0:
         return None
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
-    px, table = bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), linear_table()
-    return np.array([percentile(px[:, k], 50, table) for k in range(3)])
+    return (bgr[r0:r1:rs, c0:c1:cs].mean(axis=(0, 1)) / 255.0) ** 2.2
 
 
 def _same(a: Optional[np.ndarray], b: Optional[np.ndarray]) -> bool:
@@ -110,12 +110,14 @@ def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, flo
     running on (a touching neighbour shows its own bands and body there).
     """
     x, _, w, _ = c.bbox_px
-    own = [_colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w)) for rows in layers]
     near, far = SIDE_REACH[0] * w, SIDE_REACH[1] * w
-    for lo, hi in ((x - far, x - near), (x + w + near, x + w + far)):
-        if any(o is not c and o.bbox_px[0] < hi and o.bbox_px[0] + o.bbox_px[2] > lo for o in others):
-            return False
-        if not all(_same(o, _colour(bgr, rows, (lo, hi))) for o, rows in zip(own, layers)):
+    sides = ((x - far, x - near), (x + w + near, x + w + far))
+    if any(o is not c and o.bbox_px[0] < hi and o.bbox_px[0] + o.bbox_px[2] > lo for o in others for lo, hi in sides):
+        return False
+    # body first: beside most real landmarks it is the background, and one differing layer ends the test
+    for rows in reversed(layers):
+        own = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
+        if not all(_same(own, _colour(bgr, rows, side)) for side in sides):
             return False
     return True
 
@@ -147,8 +149,12 @@ def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
 
 def height_off_m(c: BandCentroids, model: ModelParams, cam: CameraIntrinsics) -> Tuple[float, float]:
     """``(off_m, depth_m)``: how far the candidate's centre lies below the fitted landmark height, and its depth."""
-    (xr, yr), (xb, yb) = normalised(np.array([c.red_xy_px, c.blue_xy_px]), cam)
-    l_n = float(np.hypot(xb - xr, yb - yr))
+    if cam.has_distortion:
+        (xr, yr), (xb, yb) = normalised(np.array([c.red_xy_px, c.blue_xy_px]), cam)
+    else:  # as model.pinhole_reading: the common case without numpy
+        xr, yr = (c.red_xy_px[0] - cam.cx_px) / cam.fx_px, (c.red_xy_px[1] - cam.cy_px) / cam.fy_px
+        xb, yb = (c.blue_xy_px[0] - cam.cx_px) / cam.fx_px, (c.blue_xy_px[1] - cam.cy_px) / cam.fy_px
+    l_n = math.hypot(xb - xr, yb - yr)
     depth = model.spacing_m / max(l_n, 1e-9)
     return (0.5 * (yr + yb) - model.horizon_y_n) * depth - model.centre_below_m, depth
 
