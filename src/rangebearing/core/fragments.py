@@ -34,6 +34,7 @@ MIN_SHARE = 0.15  # share of a silhouette each fragment joined across a gap must
 WHOLE_TOL = 0.3  # the taller piece of a split must be within this share of one silhouette
 WIDE = 1.1  # a run wider than this many silhouettes of its taller part is examined for a step
 JOIN_TOL = 0.3  # fragments joined across a gap make at most 1 + JOIN_TOL silhouettes
+TRIM_WIDE, TRIM_KEEP = 1.1, 0.7  # a fragment this much too wide gives up a neighbour's columns if this much is left
 BRIDGE = 2  # columns between two pieces that need no look at the bands (as the column scan bridges)
 BAND_SHARE = 0.75  # share of the gap's columns where a band must continue (the obstacle may cross the other)
 
@@ -124,6 +125,7 @@ def join_fragments(
     agree = (np.abs(y1[:, None] - y1[None, :]) <= tol) & (np.abs(y2[:, None] - y2[None, :]) <= tol)
     np.fill_diagonal(agree, False)
     parent = list(range(len(f)))
+    t0, t1 = c0.copy(), c1.copy()  # a fragment's columns after giving up those of a neighbour it overlaps
 
     def root(i: int) -> int:
         while parent[i] != i:
@@ -151,6 +153,19 @@ def join_fragments(
                 if max(_band_share(red, (ye1 - hb + 1, ye1 + 1), lo, hi),
                        _band_share(blue, (ye2, ye2 + hb), lo, hi)) < BAND_SHARE:
                     continue
+        else:  # overlapping: one structure in two windows, unless together they add up to too wide a one
+            whole = max(c1[a], c1[b]) - c0[a]
+            if whole > max(c1[a] - c0[a], c1[b] - c0[b]) + 1 and whole > (1 + JOIN_TOL) * width_k * max(g[a], g[b]):
+                # two landmarks side by side whose edges agree within a pixel or two (e.g. 1.1 and 1.4 m): the
+                # shared columns are the narrower one's when the wider is too wide for its own white body
+                wide, other = (a, b) if c1[a] - c0[a] > c1[b] - c0[b] else (b, a)
+                sil = width_k * g[wide]
+                if (c1[wide] - c0[wide]) > TRIM_WIDE * sil and (c1[wide] - c0[wide] - shared) >= TRIM_KEEP * sil:
+                    if wide == a:
+                        t1[a] = min(t1[a], c0[b])
+                    else:
+                        t0[b] = max(t0[b], c1[a])
+                continue
         parent[root(int(i))] = root(int(j))
     groups: dict = {}
     for i in range(len(f)):
@@ -158,12 +173,13 @@ def join_fragments(
     out = []
     for members in sorted(groups.values(), key=min):
         if len(members) == 1:
-            out.append(tuple(frags[members[0]]))
+            k = members[0]
+            out.append((float(t0[k]), float(t1[k]), *frags[k][2:]))
             continue
         m = f[members]
-        w = m[:, 1] - m[:, 0]
-        widest = m[int(np.argmax(w))]
-        out.append((float(m[:, 0].min()), float(m[:, 1].max()), *map(float, widest[2:])))
+        lo, hi = t0[members], t1[members]
+        widest = m[int(np.argmax(hi - lo))]
+        out.append((float(lo.min()), float(hi.max()), *map(float, widest[2:])))
     return out  # type: ignore[return-value]
 
 
@@ -178,3 +194,75 @@ def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], br
     body = v[rrows[1] - top : brows[0] - top]
     bands = np.concatenate((v[: rrows[1] - top].ravel(), v[brows[0] - top :].ravel()))
     return body.size == 0 or bands.size == 0 or median(body) >= BODY_V_SHARE * median(bands)
+
+
+EXTEND_MAX = 1.2  # an extended landmark spans at most this many silhouettes (an off-axis outline is wider)
+EXTEND_BLUE = 0.5  # share of the extension's columns where the blue band must show (a bracket hides a sliver)
+
+
+def _band_columns(mask: np.ndarray, rows: Tuple[int, int], c0: int, c1: int) -> np.ndarray:
+    """Per column of ``[c0, c1)`` (clipped to the mask): whether ``mask`` is mostly set in ``rows``."""
+    r0, r1 = max(0, rows[0]), max(0, min(mask.shape[0], rows[1]))
+    c0, c1 = max(0, c0), min(mask.shape[1], c1)
+    if r1 <= r0 or c1 <= c0:
+        return np.zeros(0, bool)
+    return (mask[r0:r1, c0:c1] > 0).mean(axis=0) > 0.5
+
+
+def _reach(cols: np.ndarray) -> int:
+    """How many leading columns of ``cols`` are set, gaps of up to ``BRIDGE`` bridged (-1: it never stops)."""
+    last, miss = -1, 0
+    for k, on in enumerate(cols.tolist()):
+        if on:
+            last, miss = k, 0
+        else:
+            miss += 1
+            if miss > BRIDGE:
+                return last + 1
+    return -1
+
+
+def extend_along_bands(
+    frag: Fragment, red: np.ndarray, blue: np.ndarray, band_k: float, width_k: float
+) -> Tuple[float, float, float]:
+    """A fragment too narrow to report, extended along its bands where something hides its white body.
+
+    A robot's own camera board in front of a near landmark's white body (and its bracket over a
+    sliver of the blue band) leaves only a piece of the body red→white→blue, but both bands run on
+    at their rows, behind the board, to the cylinder's limb. On each side the red band is followed
+    until it ends; the extension stands when it ends within ``EXTEND_MAX`` silhouettes (a red wall
+    or a neighbour's band at the same rows runs on: no landmark's limb) and the blue band shows in
+    ``EXTEND_BLUE`` of the added columns.
+
+    Returns ``(c0, c1, seen)``: the extended columns and the share of the silhouette's area seen
+    (both bands where they show, the white body over the fragment's columns only); the fragment's
+    own columns and 1 when nothing extends.
+    """
+    c0, c1, y1, y2, g = frag[0], frag[1], frag[2], frag[3], frag[4]
+    a, z = int(c0), int(c1)
+    hb = max(1, round(band_k * g))
+    rrows = (round(y1 - hb + 1), int(y1) + 1)
+    brows = (int(y2), round(y2 + hb))
+    cap = int(EXTEND_MAX * width_k * g) - (z - a)
+    if cap <= 0:
+        return c0, c1, 1.0
+    right = _band_columns(red, rrows, z, z + cap + BRIDGE + 1)
+    left = _band_columns(red, rrows, a - cap - BRIDGE - 1, a)[::-1]
+    out = [a, z]
+    for side, cols in ((1, right), (0, left)):
+        n = _reach(cols)
+        if n <= 0 or n > cap:  # no band beyond, or no limb within reach (a wall, a neighbour, the frame's edge)
+            continue
+        lo, hi = (z, z + n) if side else (a - n, a)
+        if _band_columns(blue, brows, lo, hi).mean() < EXTEND_BLUE:
+            continue
+        out[side] = hi if side else lo
+    e0, e1 = out
+    if (e0, e1) == (a, z):
+        return c0, c1, 1.0
+    seen_r = _band_columns(red, rrows, e0, e1)
+    seen_b = _band_columns(blue, brows, e0, e1)
+    seen_r[a - e0 : z - e0] = seen_b[a - e0 : z - e0] = True
+    # the silhouette's area seen: both bands where they show, the white body over the fragment only
+    seen = (band_k * (seen_r.mean() + seen_b.mean()) + (z - a) / (e1 - e0)) / (2 * band_k + 1)
+    return float(e0), float(e1), float(seen)

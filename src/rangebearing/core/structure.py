@@ -34,7 +34,7 @@ import numpy as np
 
 from .._compat import frozen
 from .columns import bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
-from .fragments import MIN_PIECE, Fragment, join_fragments, lit_like_bands, split_runs
+from .fragments import MIN_PIECE, Fragment, extend_along_bands, join_fragments, lit_like_bands, split_runs
 from .types import BBox, LandmarkGeometry
 
 MAX_REGIONS = 128  # largest regions of each colour considered (bounds the cost of a frame full of specks)
@@ -151,15 +151,19 @@ def candidates(
         if s1 - s0 >= MIN_PIECE  # a column of edge noise neither makes nor joins a landmark
     ]
     frags = list(dict.fromkeys(frags))  # one structure is often found whole in several windows
-    for c0f, c1f, ey1, ey2, gap, med_r, med_b in join_fragments(frags, red, blue, band_k, width_k):
-        s0, s1 = int(c0f), int(c1f)
-        n = s1 - s0
+    for frag in join_fragments(frags, red, blue, band_k, width_k):
+        c0f, c1f, ey1, ey2, gap, med_r, med_b = frag
         if gap < 2:  # bridged or smoothed below the thinnest white body
             continue
         hb, w_exp = band_k * gap, width_k * gap
-        ratio = n / w_exp
         red_merged = med_r > MERGED * hb + 1
         blue_merged = med_b > MERGED * hb + 1
+        seen = 1.0
+        if (c1f - c0f) / w_exp < MIN_VISIBLE and not (red_merged or blue_merged):
+            c0f, c1f, seen = extend_along_bands(frag, red, blue, band_k, width_k)  # a body hidden, bands whole
+        s0, s1 = int(c0f), int(c1f)
+        n = s1 - s0
+        ratio = n / w_exp
         k = round(ratio)
         if ratio > 1 + SPLIT_TOL:
             if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
@@ -185,7 +189,7 @@ def candidates(
                 continue
             taken.append(rb)
             # the pattern fails in about one column at the limbs together (mixed pixels): count it back
-            vis = min(1.0, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
+            vis = min(seen, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
             out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis))
             if len(out) >= max_landmarks:
                 return occluded_sides(out, scale)
