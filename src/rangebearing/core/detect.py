@@ -171,6 +171,8 @@ def combine(
     cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
     if cols is None:
         x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
+        if c.hidden_band:  # a partly hidden band's moments are pulled off the axis: the whole one places both
+            x_r = x_b = x_b if c.hidden_band == "red" else x_r
     else:
         x_r = x_b = cols[0]
         sx = cols[1]

@@ -198,6 +198,7 @@ def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], br
 
 EXTEND_MAX = 1.2  # an extended landmark spans at most this many silhouettes (an off-axis outline is wider)
 EXTEND_BLUE = 0.5  # share of the extension's columns where the blue band must show (a bracket hides a sliver)
+HIDDEN_SHARE = 0.05  # a band seen in this much less of the columns than the other is partly hidden: no column cue
 
 
 def _band_columns(mask: np.ndarray, rows: Tuple[int, int], c0: int, c1: int) -> np.ndarray:
@@ -224,7 +225,7 @@ def _reach(cols: np.ndarray) -> int:
 
 def extend_along_bands(
     frag: Fragment, red: np.ndarray, blue: np.ndarray, band_k: float, width_k: float
-) -> Tuple[float, float, float]:
+) -> Tuple[float, float, float, str]:
     """A fragment too narrow to report, extended along its bands where something hides its white body.
 
     A robot's own camera board in front of a near landmark's white body (and its bracket over a
@@ -234,9 +235,10 @@ def extend_along_bands(
     or a neighbour's band at the same rows runs on: no landmark's limb) and the blue band shows in
     ``EXTEND_BLUE`` of the added columns.
 
-    Returns ``(c0, c1, seen)``: the extended columns and the share of the silhouette's area seen
-    (both bands where they show, the white body over the fragment's columns only); the fragment's
-    own columns and 1 when nothing extends.
+    Returns ``(c0, c1, seen, hidden)``: the extended columns, the share of the silhouette's area seen
+    (both bands where they show, the white body over the fragment's columns only) and the band seen
+    in fewer columns (``"red"``/``"blue"``, else ``""``: its moments are pulled off the axis by what
+    hides it); the fragment's own columns, 1 and ``""`` when nothing extends.
     """
     c0, c1, y1, y2, g = frag[0], frag[1], frag[2], frag[3], frag[4]
     a, z = int(c0), int(c1)
@@ -245,7 +247,7 @@ def extend_along_bands(
     brows = (int(y2), round(y2 + hb))
     cap = int(EXTEND_MAX * width_k * g) - (z - a)
     if cap <= 0:
-        return c0, c1, 1.0
+        return c0, c1, 1.0, ""
     right = _band_columns(red, rrows, z, z + cap + BRIDGE + 1)
     left = _band_columns(red, rrows, a - cap - BRIDGE - 1, a)[::-1]
     out = [a, z]
@@ -259,10 +261,12 @@ def extend_along_bands(
         out[side] = hi if side else lo
     e0, e1 = out
     if (e0, e1) == (a, z):
-        return c0, c1, 1.0
+        return c0, c1, 1.0, ""
     seen_r = _band_columns(red, rrows, e0, e1)
     seen_b = _band_columns(blue, brows, e0, e1)
     seen_r[a - e0 : z - e0] = seen_b[a - e0 : z - e0] = True
+    share_r, share_b = float(seen_r.mean()), float(seen_b.mean())
     # the silhouette's area seen: both bands where they show, the white body over the fragment only
-    seen = (band_k * (seen_r.mean() + seen_b.mean()) + (z - a) / (e1 - e0)) / (2 * band_k + 1)
-    return float(e0), float(e1), float(seen)
+    seen = (band_k * (share_r + share_b) + (z - a) / (e1 - e0)) / (2 * band_k + 1)
+    hidden = "" if abs(share_r - share_b) <= HIDDEN_SHARE else "blue" if share_b < share_r else "red"
+    return float(e0), float(e1), float(seen), hidden

@@ -54,7 +54,8 @@ class Candidate:
     edge (a same-coloured background). ``cut_left``/``cut_right``: the run
     ends at something other than the cylinder's limb (a nearer landmark, a
     neighbour, a same-coloured background). ``visible`` is the run's width over
-    the silhouette's, at most 1.
+    the silhouette's, at most 1 (for a run extended along its bands, the share of
+    the silhouette's area seen).
     """
 
     red_bbox_px: BBox
@@ -65,6 +66,7 @@ class Candidate:
     cut_left: bool
     cut_right: bool
     visible: float
+    hidden_band: str = ""  # "red"/"blue": seen in fewer of the columns (partly hidden), its moments no column cue
 
 
 def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
@@ -158,9 +160,9 @@ def candidates(
         hb, w_exp = band_k * gap, width_k * gap
         red_merged = med_r > MERGED * hb + 1
         blue_merged = med_b > MERGED * hb + 1
-        seen = 1.0
+        seen, hidden = 1.0, ""
         if (c1f - c0f) / w_exp < MIN_VISIBLE and not (red_merged or blue_merged):
-            c0f, c1f, seen = extend_along_bands(frag, red, blue, band_k, width_k)  # a body hidden, bands whole
+            c0f, c1f, seen, hidden = extend_along_bands(frag, red, blue, band_k, width_k)  # a body hidden, bands whole
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0
         ratio = n / w_exp
@@ -190,7 +192,7 @@ def candidates(
             taken.append(rb)
             # the pattern fails in about one column at the limbs together (mixed pixels): count it back
             vis = min(seen, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
-            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis))
+            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis, hidden))
             if len(out) >= max_landmarks:
                 return occluded_sides(out, scale)
     return occluded_sides(out, scale)
