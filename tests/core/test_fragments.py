@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rangebearing.core.fragments import height_steps, join_fragments
+from rangebearing.core.fragments import extend_along_bands, height_steps, join_fragments
 
 WIDTH_K, BAND_K = 35 / 40, 15 / 40
 
@@ -54,3 +54,44 @@ def test_one_structure_found_in_two_windows_is_one_fragment():
     frags = [(10.0, 30.0, 19.0, 52.0, 32.0, 10.0, 10.0), (12.0, 38.0, 20.0, 52.0, 31.0, 10.0, 10.0)]
     (joined,) = join_fragments(frags, red, blue, BAND_K, WIDTH_K)
     assert joined[:2] == (10.0, 38.0) and joined[4] == 31.0  # the widest member's edges
+
+
+def test_two_landmarks_side_by_side_with_agreeing_edges_are_not_one_too_wide_fragment():
+    # a far landmark (white 10 rows) beside a nearer one (white 12); the wider window's run took
+    # 4 of the far one's columns: it gives them up, and the two stay apart
+    red, blue = masks()
+    far = (24.0, 31.0, 14.0, 25.0, 10.0, 4.0, 4.0)
+    near = (27.0, 40.0, 14.0, 27.0, 12.0, 5.0, 5.0)  # 13 columns for a silhouette of 10.5
+    out = join_fragments([far, near], red, blue, BAND_K, WIDTH_K)
+    assert [f[:2] for f in out] == [(24.0, 31.0), (31.0, 40.0)]
+
+
+def landmark_behind_its_camera(red, blue, c0=20, c1=48, board=(34, 60)):
+    """A landmark 28 columns wide (white 32 rows) whose own camera board hides its white body from
+    ``board[0]`` on, and its bracket a sliver of the blue band."""
+    red[10:22, c0:c1] = 255
+    blue[54:66, c0:c1] = 255
+    blue[54:66, 40:42] = 0  # the bracket
+    return (float(c0), float(board[0]), 21.0, 54.0, 32.0, 12.0, 12.0)  # the fragment left of the board
+
+
+def test_a_fragment_is_extended_along_its_bands_to_the_limb():
+    red, blue = masks()
+    frag = landmark_behind_its_camera(red, blue)
+    c0, c1, seen, hidden = extend_along_bands(frag, red, blue, BAND_K, WIDTH_K)
+    assert (c0, c1) == (20.0, 48.0)
+    assert 0.6 < seen < 1.0 and hidden == "blue"  # the body behind the board is not seen; the bracket hid blue
+
+
+def test_no_extension_when_the_band_runs_on_like_a_wall_or_the_other_band_is_missing():
+    red, blue = masks()
+    frag = landmark_behind_its_camera(red, blue)
+    wall = red.copy()
+    wall[10:22, :] = 255  # a red wall at the band's rows: no limb within reach
+    assert extend_along_bands(frag, wall, blue, BAND_K, WIDTH_K)[:2] == (20.0, 34.0)
+    wall[10:22, :] = 0
+    wall[0:22, 14:50] = 255  # a red wall between two masts: it ends, but the "band" has no top
+    assert extend_along_bands(frag, wall, blue, BAND_K, WIDTH_K)[:2] == (20.0, 34.0)
+    no_blue = blue.copy()
+    no_blue[:, 34:] = 0
+    assert extend_along_bands(frag, red, no_blue, BAND_K, WIDTH_K)[:2] == (20.0, 34.0)

@@ -232,8 +232,9 @@ def extend_along_bands(
     sliver of the blue band) leaves only a piece of the body red→white→blue, but both bands run on
     at their rows, behind the board, to the cylinder's limb. On each side the red band is followed
     until it ends; the extension stands when it ends within ``EXTEND_MAX`` silhouettes (a red wall
-    or a neighbour's band at the same rows runs on: no landmark's limb) and the blue band shows in
-    ``EXTEND_BLUE`` of the added columns.
+    or a neighbour's band at the same rows runs on: no landmark's limb), the blue band shows in
+    ``EXTEND_BLUE`` of the added columns and the red band has a top (a red wall seen between two
+    masts has none: the column scan's window may have cut its run short).
 
     Returns ``(c0, c1, seen, hidden)``: the extended columns, the share of the silhouette's area seen
     (both bands where they show, the white body over the fragment's columns only) and the band seen
@@ -261,6 +262,9 @@ def extend_along_bands(
         out[side] = hi if side else lo
     e0, e1 = out
     if (e0, e1) == (a, z):
+        return c0, c1, 1.0, ""
+    above = (round(y1 - 2 * hb - 1), round(y1 - 1.3 * hb))
+    if _band_columns(red, above, e0, e1).mean() >= 0.5:  # red above the band too: a red wall, no band of its own
         return c0, c1, 1.0, ""
     seen_r = _band_columns(red, rrows, e0, e1)
     seen_b = _band_columns(blue, brows, e0, e1)
