@@ -38,7 +38,8 @@ TRIM_WIDE, TRIM_KEEP = 1.1, 0.7  # a fragment this much too wide gives up a neig
 BRIDGE = 2  # columns between two pieces that need no look at the bands (as the column scan bridges)
 BAND_SHARE = 0.75  # share of the gap's columns where a band must continue (the obstacle may cross the other)
 
-BODY_V_SHARE = 0.7  # the white body's median V over the bands' (white paint is brighter than either, lit alike)
+BODY_V_SHARE = 0.7  # the white body's V (upper quartile) over the bands' median (white paint is brighter, lit alike)
+BODY_PCT = 0.75
 
 # (c0, c1, y1, y2, gap, run_r, run_b): columns [c0, c1), median inner edges y1 (red bottom) and
 # y2 (blue top), white height gap = y2 − y1 − 1, median band runs
@@ -186,14 +187,20 @@ def join_fragments(
 def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], brows: Tuple[int, int]) -> bool:
     """Whether the body between a structure's bands (columns ``[c0, c1)``) is as bright as a white
     body beside them: white paint is at least as bright as the bands' brightest channel in any
-    light, so a dark robot chassis or shadow between a red box and a blue mat is no white body.
+    light, so a dark robot chassis or shadow between a red box and a blue mat is no white body. The
+    body's level is its upper quartile: something in front of it (its own camera) darkens only a part.
 
     ``hsv`` is indexed once, with two slices (it may convert only that window)."""
     top = max(0, rrows[0])
     v = hsv[top : max(top, brows[1]), c0:c1][..., 2]
     body = v[rrows[1] - top : brows[0] - top]
     bands = np.concatenate((v[: rrows[1] - top].ravel(), v[brows[0] - top :].ravel()))
-    return body.size == 0 or bands.size == 0 or median(body) >= BODY_V_SHARE * median(bands)
+    if body.size == 0 or bands.size == 0:
+        return True
+    # the body's upper quartile: a robot's own camera board in front of it darkens only a part
+    flat = body.ravel()
+    k = int(BODY_PCT * (flat.size - 1))
+    return float(np.partition(flat, k)[k]) >= BODY_V_SHARE * median(bands)
 
 
 EXTEND_MAX = 1.2  # an extended landmark spans at most this many silhouettes (an off-axis outline is wider)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import List, Tuple
+from typing import List, Optional, Tuple
 
 import cv2
 import numpy as np
@@ -67,6 +67,7 @@ class Candidate:
     cut_right: bool
     visible: float
     hidden_band: str = ""  # "red"/"blue": seen in fewer of the columns (partly hidden), its moments no column cue
+    body_cols_px: Optional[Tuple[int, int]] = None  # [x0, x1) where the white body shows, when only part of it does
 
 
 def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
@@ -177,7 +178,7 @@ def candidates(
             pieces = [(float(s0), float(s1))]
         rrows = (round(ey1 - hb + 1), int(ey1) + 1)
         brows = (int(ey2), round(ey2 + hb))
-        if not lit_like_bands(hsv, s0, s1, rrows, brows):
+        if not lit_like_bands(hsv, int(frag[0]), int(frag[1]), rrows, brows):  # where the white body shows
             continue
         reach = 1 + round(0.08 * w_exp)
         for q, (p0, p1) in enumerate(pieces):
@@ -192,7 +193,8 @@ def candidates(
             taken.append(rb)
             # the pattern fails in about one column at the limbs together (mixed pixels): count it back
             vis = min(seen, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
-            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis, hidden))
+            body = None if seen == 1.0 else (int(frag[0]) * scale, int(frag[1]) * scale)
+            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis, hidden, body))
             if len(out) >= max_landmarks:
                 return occluded_sides(out, scale)
     return occluded_sides(out, scale)
