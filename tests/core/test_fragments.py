@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rangebearing.core.fragments import extend_along_bands, height_steps, join_fragments
+from rangebearing.core.fragments import extend_along_bands, height_steps, join_fragments, lit_like_bands
 
 WIDTH_K, BAND_K = 35 / 40, 15 / 40
 
@@ -95,3 +95,17 @@ def test_no_extension_when_the_band_runs_on_like_a_wall_or_the_other_band_is_mis
     no_blue = blue.copy()
     no_blue[:, 34:] = 0
     assert extend_along_bands(frag, red, no_blue, BAND_K, WIDTH_K)[:2] == (20.0, 34.0)
+
+
+def test_a_white_body_partly_behind_a_camera_board_is_lit_like_its_bands_a_dark_chassis_is_not():
+    hsv = np.zeros((60, 30, 3), np.uint8)
+    hsv[0:10, :, 2] = 180  # red band
+    hsv[40:50, :, 2] = 120  # blue band (darker in V)
+    hsv[10:40, :, 2] = 210  # white body
+    rrows, brows = (0, 10), (40, 50)
+    assert lit_like_bands(hsv, 0, 30, rrows, brows)
+    hsv[12:36, 3:27, 2] = 60  # the robot's own camera board over 64 % of the body: its median is dark
+    assert np.median(hsv[10:40, :, 2]) < 0.7 * 150
+    assert lit_like_bands(hsv, 0, 30, rrows, brows)
+    hsv[10:40, :, 2] = 60  # a dark chassis between a red box and a blue mat
+    assert not lit_like_bands(hsv, 0, 30, rrows, brows)

@@ -159,7 +159,7 @@ def join_fragments(
             if whole > max(c1[a] - c0[a], c1[b] - c0[b]) + 1 and whole > (1 + JOIN_TOL) * width_k * max(g[a], g[b]):
                 # two landmarks side by side whose edges agree within a pixel or two (e.g. 1.1 and 1.4 m): the
                 # shared columns are the narrower one's when the wider is too wide for its own white body
-                wide, other = (a, b) if c1[a] - c0[a] > c1[b] - c0[b] else (b, a)
+                wide = a if c1[a] - c0[a] > c1[b] - c0[b] else b
                 sil = width_k * g[wide]
                 if (c1[wide] - c0[wide]) > TRIM_WIDE * sil and (c1[wide] - c0[wide] - shared) >= TRIM_KEEP * sil:
                     if wide == a:

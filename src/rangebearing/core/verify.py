@@ -47,7 +47,9 @@ the checks here ask for:
   there: touching neighbours show their own bands and bodies) is no landmark.
 
 Levels are taken in linear light over the middle three fifths of the
-candidate's visible columns (limbs darken and mix with the background). Each
+candidate's visible columns (limbs darken and mix with the background); of
+the columns where its white body shows, when its own camera hides the rest
+(``Candidate.body_cols_px``). Each
 check compares one channel with itself, so the white balance cancels.
 """
 
@@ -191,17 +193,14 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     band = spacing * geometry.band_height_m / geometry.band_spacing_m
     white = spacing * (geometry.height_m - 2 * geometry.band_height_m) / geometry.band_spacing_m
     x, _, w, _ = c.bbox_px
+    if cand is not None and cand.body_cols_px is not None:  # its own camera hides the rest of the body
+        x, w = cand.body_cols_px[0], cand.body_cols_px[1] - cand.body_cols_px[0]  # bands and body where it shows
     cols = (x + 0.2 * w, x + 0.8 * w)
     red_r = _level(bgr, (ry - 0.25 * band, ry + 0.25 * band), cols, 2, BAND_PCT)
     blue_b = _level(bgr, (by - 0.25 * band, by + 0.25 * band), cols, 0, BAND_PCT)
     body = (ry + 0.5 * band + 0.15 * white, by - 0.5 * band - 0.15 * white)
-    if cand is not None and cand.body_cols_px is not None:  # its own camera hides the rest of the body
-        b0, b1 = cand.body_cols_px
-        body_cols = (b0 + 0.2 * (b1 - b0), b0 + 0.8 * (b1 - b0))
-    else:
-        body_cols = cols
-    white_r = _level(bgr, body, body_cols, 2, WHITE_PCT)
-    white_b = _level(bgr, body, body_cols, 0, WHITE_PCT)
+    white_r = _level(bgr, body, cols, 2, WHITE_PCT)
+    white_b = _level(bgr, body, cols, 0, WHITE_PCT)
     if red_r > BAND_OVER_WHITE * white_r or blue_b > BAND_OVER_WHITE * white_b:
         return "the white body is darker than a band in the band's own channel"
     if striped(bgr, c, ((ry - 0.25 * band, ry + 0.25 * band), body), others):
