@@ -205,6 +205,7 @@ def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], br
 
 EXTEND_MAX = 1.2  # an extended landmark spans at most this many silhouettes (an off-axis outline is wider)
 EXTEND_BLUE = 0.5  # share of the extension's columns where the blue band must show (a bracket hides a sliver)
+ABOVE_RED = 0.25  # share of red pixels in the two band heights above the band that makes it no band of its own
 HIDDEN_SHARE = 0.05  # a band seen in this much less of the columns than the other is partly hidden: no column cue
 
 
@@ -240,8 +241,9 @@ def extend_along_bands(
     at their rows, behind the board, to the cylinder's limb. On each side the red band is followed
     until it ends; the extension stands when it ends within ``EXTEND_MAX`` silhouettes (a red wall
     or a neighbour's band at the same rows runs on: no landmark's limb), the blue band shows in
-    ``EXTEND_BLUE`` of the added columns and the red band has a top (a red wall seen between two
-    masts has none: the column scan's window may have cut its run short).
+    ``EXTEND_BLUE`` of the added columns and the red band has a top: little red in the two band
+    heights above it (a red wall seen between two masts has none, a brick wall's courses come back
+    above a mortar line; the column scan's window may have cut their runs short).
 
     Returns ``(c0, c1, seen, hidden)``: the extended columns, the share of the silhouette's area seen
     (both bands where they show, the white body over the fragment's columns only) and the band seen
@@ -270,8 +272,8 @@ def extend_along_bands(
     e0, e1 = out
     if (e0, e1) == (a, z):
         return c0, c1, 1.0, ""
-    above = (round(y1 - 2 * hb - 1), round(y1 - 1.3 * hb))
-    if _band_columns(red, above, e0, e1).mean() >= 0.5:  # red above the band too: a red wall, no band of its own
+    r0, r1 = max(0, round(y1 - 3 * hb)), max(0, round(y1 - 1.3 * hb))
+    if r1 > r0 and (red[r0:r1, e0:e1] > 0).mean() >= ABOVE_RED:  # red above the band too: a red (brick) wall
         return c0, c1, 1.0, ""
     seen_r = _band_columns(red, rrows, e0, e1)
     seen_b = _band_columns(blue, brows, e0, e1)

@@ -131,7 +131,8 @@ def candidates(
     """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
 
     Returns at most ``max_landmarks`` candidates in full-resolution pixels,
-    those with the widest shared columns first. The work is bounded: at most
+    the nearest (tallest white body) first: a structure whose red band shares most
+    of a nearer one's is part of it (edge noise inside its band). The work is bounded: at most
     ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
     pairs per landmark wanted are examined, whatever the frame holds.
     """
@@ -154,7 +155,8 @@ def candidates(
         if s1 - s0 >= MIN_PIECE  # a column of edge noise neither makes nor joins a landmark
     ]
     frags = list(dict.fromkeys(frags))  # one structure is often found whole in several windows
-    for frag in join_fragments(frags, red, blue, band_k, width_k):
+    # nearest (tallest white body) first: a speck of edge noise inside a landmark's band must not take its place
+    for frag in sorted(join_fragments(frags, red, blue, band_k, width_k), key=lambda f: -f[4]):
         c0f, c1f, ey1, ey2, gap, med_r, med_b = frag
         if gap < 2:  # bridged or smoothed below the thinnest white body
             continue
