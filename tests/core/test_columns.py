@@ -4,13 +4,13 @@ against each window scanned on its own."""
 import numpy as np
 import pytest
 
-from rangebearing.core.columns import WHITE_SHARE, bridge, column_edges, runs, window_runs
+from rangebearing.core.columns import TOP_TOL, WHITE_SHARE, bridge, column_edges, runs, window_runs
 
 
 def reference_column(red, blue, white):
     """``(ok, y1, y2, run_r, run_b)`` of one column, pixel by pixel, as the docstring of column_edges says."""
     h = len(red)
-    best = None
+    pairs = []
     for y2 in range(1, h):
         if not blue[y2] or blue[y2 - 1]:
             continue  # not a blue top
@@ -22,9 +22,11 @@ def reference_column(red, blue, white):
         whites = int(sum(white[y1 + 1 : y2]))
         if gap < 2 or whites < WHITE_SHARE * gap:
             continue
-        share = whites / gap - 1e-3 * gap
-        if best is None or share > best[0]:
-            best = (share, y1, y2)
+        pairs.append((whites / gap, y1, y2))
+    best = None
+    if pairs:  # the top-most of those nearly as white as the whitest
+        whitest = max(p[0] for p in pairs)
+        best = min((p for p in pairs if p[0] >= whitest - TOP_TOL), key=lambda p: p[2])
     if best is None:
         y1, y2, ok = -1, 0, False
         run_r = 0 if red[0] else -1
@@ -83,3 +85,19 @@ def test_stacked_windows_give_each_window_its_own_runs():
             for s0, s1 in runs(ok, e1, e2)
         ]
         assert found == want
+
+
+def test_a_landmark_above_its_robot_wins_the_column_over_the_robots_whiter_red_white_blue():
+    # the landmark: red 2-3, body 4-11 (one bluish rim row), its blue band merged with a blue wall 12-15;
+    # its robot below: red top plate 20-21, pale bumper 22-26 (all white), blue floor 27-
+    h = 32
+    red, blue, white = np.zeros(h, bool), np.zeros(h, bool), np.zeros(h, bool)
+    red[2:4] = True
+    white[4:11] = True
+    blue[12:16] = True
+    red[20:22] = True
+    white[22:27] = True
+    blue[27:] = True
+    ok, y1, y2, _, _ = column_edges(red[:, None], blue[:, None], white[:, None])
+    assert ok[0] and (y1[0], y2[0]) == (3, 12)
+    assert reference_column(red, blue, white)[:3] == (True, 3, 12)

@@ -15,6 +15,7 @@ WHITE_SHARE = 0.6  # share of the rows between the edges that must be white
 EDGE_STEP = 1  # largest jump of an edge between neighbouring columns (plus 5 % of h)
 BRIDGE = 2  # columns of a gap bridged between agreeing edges
 WHITE_S_MAX, WHITE_V_MIN = 80, 40  # the white body: low saturation, not dark
+TOP_TOL = 0.2  # a pair this much less white than a column's whitest still wins when it is above it
 
 
 def _nonzero(a: np.ndarray) -> np.ndarray:
@@ -27,7 +28,9 @@ def column_edges(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
 
     ``y1`` is the last red row above the blue-top row ``y2``, with at least
     ``WHITE_SHARE`` of the rows between them white; of several such pairs in a
-    column, the whitest (then the shortest) wins. ``run_r``/``run_b`` are the
+    column, the top-most of those within ``TOP_TOL`` of the whitest wins: a
+    landmark stands above its robot, whose red top plate, pale bumper and blue
+    floor (or mat) make a pair as white as the landmark's own. ``run_r``/``run_b`` are the
     lengths of the red run ending at ``y1`` and the blue run starting at ``y2``.
     Where no pair qualifies ``ok`` is False, ``y1`` −1 and ``y2`` 0.
     """
@@ -69,13 +72,15 @@ def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     cum_w = white.reshape(-1).cumsum(dtype=np.int32)
     whites = cum_w[tops - 1] - cum_w[np.where(has, above, 0)]  # white rows strictly between y1 and the top
     valid = has & (gap >= 2) & (whites >= WHITE_SHARE * gap)
-    share = whites / np.maximum(gap, 1) - 1e-3 * gap
+    share = whites / np.maximum(gap, 1)
     ok = np.zeros(w, bool)
     y2 = np.zeros(w, np.int64)
     b1 = np.full(w, -1, np.int64)
     v = _nonzero(valid)
     if len(v):
-        v = v[np.lexsort((row[v], -share[v], col[v]))]  # per column: whitest, then the shortest
+        best = np.full(w, -1.0)
+        np.maximum.at(best, col[v], share[v])
+        v = v[share[v] >= best[col[v]] - TOP_TOL]  # tops are in column, then row order: the first is the top-most
         cv = col[v]
         first = np.ones(len(v), bool)
         first[1:] = cv[1:] != cv[:-1]
