@@ -234,7 +234,7 @@ def _reach(cols: np.ndarray) -> int:
 def extend_along_bands(
     frag: Fragment, red: np.ndarray, blue: np.ndarray, band_k: float, width_k: float
 ) -> Tuple[float, float, float, str]:
-    """A fragment too narrow to report, extended along its bands where something hides its white body.
+    """A fragment narrower than a silhouette, extended along its bands where something hides its white body.
 
     A robot's own camera board in front of a near landmark's white body (and its bracket over a
     sliver of the blue band) leaves only a piece of the body red→white→blue, but both bands run on
@@ -256,7 +256,7 @@ def extend_along_bands(
     rrows = (round(y1 - hb + 1), int(y1) + 1)
     brows = (int(y2), round(y2 + hb))
     cap = int(EXTEND_MAX * width_k * g) - (z - a)
-    if cap <= 0:
+    if cap <= 0 or z - a < MIN_SHARE * width_k * g:  # a column or two of edge noise is extended to nothing
         return c0, c1, 1.0, ""
     right = _band_columns(red, rrows, z, z + cap + BRIDGE + 1)
     left = _band_columns(red, rrows, a - cap - BRIDGE - 1, a)[::-1]

@@ -41,6 +41,7 @@ MAX_REGIONS = 128  # largest regions of each colour considered (bounds the cost 
 MAX_PAIRS_PER_LANDMARK = 4  # region pairs examined per landmark wanted
 MERGED = 1.7  # a band run longer than this many expected band heights is merged with something
 SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
+EXTEND_BELOW = 1.0  # narrower runs than this share of a silhouette are extended along their bands when they run on
 MIN_VISIBLE = 0.5  # narrower runs than this share of a silhouette are not reported (findable: 60 %)
 
 
@@ -164,7 +165,7 @@ def candidates(
         red_merged = med_r > MERGED * hb + 1
         blue_merged = med_b > MERGED * hb + 1
         seen, hidden = 1.0, ""
-        if (c1f - c0f) / w_exp < MIN_VISIBLE and not (red_merged or blue_merged):
+        if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):
             c0f, c1f, seen, hidden = extend_along_bands(frag, red, blue, band_k, width_k)  # a body hidden, bands whole
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0
