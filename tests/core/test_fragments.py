@@ -78,9 +78,18 @@ def landmark_behind_its_camera(red, blue, c0=20, c1=48, board=(34, 60)):
 def test_a_fragment_is_extended_along_its_bands_to_the_limb():
     red, blue = masks()
     frag = landmark_behind_its_camera(red, blue)
-    c0, c1, seen, hidden = extend_along_bands(frag, red, blue, BAND_K, WIDTH_K)
+    c0, c1, seen, hidden, cut_left, cut_right = extend_along_bands(frag, red, blue, BAND_K, WIDTH_K)
     assert (c0, c1) == (20.0, 48.0)
     assert 0.6 < seen < 1.0 and hidden == "blue"  # the body behind the board is not seen; the bracket hid blue
+    assert not cut_left and not cut_right  # both bands end together at the limb
+
+
+def test_an_extension_that_ends_at_something_over_the_red_band_is_cut_there():
+    red, blue = masks()
+    frag = landmark_behind_its_camera(red, blue)
+    red[16:22, 44:48] = 0  # the board over the red band's end: red ends 4 columns before the blue band
+    c0, c1, _, _, cut_left, cut_right = extend_along_bands(frag, red, blue, BAND_K, WIDTH_K)
+    assert (c0, c1) == (20.0, 44.0) and cut_right and not cut_left
 
 
 def test_no_extension_when_the_band_runs_on_like_a_wall_or_the_other_band_is_missing():

@@ -206,6 +206,7 @@ def lit_like_bands(hsv: np.ndarray, c0: int, c1: int, rrows: Tuple[int, int], br
 EXTEND_MAX = 1.2  # an extended landmark spans at most this many silhouettes (an off-axis outline is wider)
 EXTEND_BLUE = 0.5  # share of the extension's columns where the blue band must show (a bracket hides a sliver)
 ABOVE_RED = 0.25  # share of red pixels in the two band heights above the band that makes it no band of its own
+LIMB_PX = 1  # columns between the two bands' ends at a limb
 HIDDEN_SHARE = 0.05  # a band seen in this much less of the columns than the other is partly hidden: no column cue
 
 
@@ -233,7 +234,7 @@ def _reach(cols: np.ndarray) -> int:
 
 def extend_along_bands(
     frag: Fragment, red: np.ndarray, blue: np.ndarray, band_k: float, width_k: float
-) -> Tuple[float, float, float, str]:
+) -> Tuple[float, float, float, str, bool, bool]:
     """A fragment narrower than a silhouette, extended along its bands where something hides its white body.
 
     A robot's own camera board in front of a near landmark's white body (and its bracket over a
@@ -245,10 +246,13 @@ def extend_along_bands(
     heights above it (a red wall seen between two masts has none, a brick wall's courses come back
     above a mortar line; the column scan's window may have cut their runs short).
 
-    Returns ``(c0, c1, seen, hidden)``: the extended columns, the share of the silhouette's area seen
-    (both bands where they show, the white body over the fragment's columns only) and the band seen
-    in fewer columns (``"red"``/``"blue"``, else ``""``: its moments are pulled off the axis by what
-    hides it); the fragment's own columns, 1 and ``""`` when nothing extends.
+    Returns ``(c0, c1, seen, hidden, cut_left, cut_right)``: the extended columns, the share of the
+    silhouette's area seen (both bands where they show, the white body over the fragment's columns
+    only), the band seen in fewer columns (``"red"``/``"blue"``, else ``""``: its moments are pulled
+    off the axis by what hides it) and, per side, whether the extension ends elsewhere than at a limb
+    (the blue band ends more than ``LIMB_PX`` from the red one: the camera board hides the red band's
+    end, or the mast the blue one's); the fragment's own columns, 1, ``""`` and no cut when nothing
+    extends.
     """
     c0, c1, y1, y2, g = frag[0], frag[1], frag[2], frag[3], frag[4]
     a, z = int(c0), int(c1)
@@ -257,10 +261,11 @@ def extend_along_bands(
     brows = (int(y2), round(y2 + hb))
     cap = int(EXTEND_MAX * width_k * g) - (z - a)
     if cap <= 0 or z - a < MIN_SHARE * width_k * g:  # a column or two of edge noise is extended to nothing
-        return c0, c1, 1.0, ""
+        return c0, c1, 1.0, "", False, False
     right = _band_columns(red, rrows, z, z + cap + BRIDGE + 1)
     left = _band_columns(red, rrows, a - cap - BRIDGE - 1, a)[::-1]
     out = [a, z]
+    cut = [False, False]
     for side, cols in ((1, right), (0, left)):
         n = _reach(cols)
         if n <= 0 or n > cap:  # no band beyond, or no limb within reach (a wall, a neighbour, the frame's edge)
@@ -269,12 +274,19 @@ def extend_along_bands(
         if _band_columns(blue, brows, lo, hi).mean() < EXTEND_BLUE:
             continue
         out[side] = hi if side else lo
+        # a limb ends both bands at one column; where they end apart something hides the red band's end
+        if side:
+            on = np.flatnonzero(_band_columns(blue, brows, lo, hi + LIMB_PX + 1))
+        else:
+            on = np.flatnonzero(_band_columns(blue, brows, lo - LIMB_PX - 1, hi)[::-1])
+        reach_b = int(on[-1]) + 1 if len(on) else 0
+        cut[side] = abs(reach_b - n) > LIMB_PX
     e0, e1 = out
     if (e0, e1) == (a, z):
-        return c0, c1, 1.0, ""
+        return c0, c1, 1.0, "", False, False
     r0, r1 = max(0, round(y1 - 3 * hb)), max(0, round(y1 - 1.3 * hb))
     if r1 > r0 and (red[r0:r1, e0:e1] > 0).mean() >= ABOVE_RED:  # red above the band too: a red (brick) wall
-        return c0, c1, 1.0, ""
+        return c0, c1, 1.0, "", False, False
     seen_r = _band_columns(red, rrows, e0, e1)
     seen_b = _band_columns(blue, brows, e0, e1)
     seen_r[a - e0 : z - e0] = seen_b[a - e0 : z - e0] = True
@@ -282,4 +294,4 @@ def extend_along_bands(
     # the silhouette's area seen: both bands where they show, the white body over the fragment only
     seen = (band_k * (share_r + share_b) + (z - a) / (e1 - e0)) / (2 * band_k + 1)
     hidden = "" if abs(share_r - share_b) <= HIDDEN_SHARE else "blue" if share_b < share_r else "red"
-    return float(e0), float(e1), float(seen), hidden
+    return float(e0), float(e1), float(seen), hidden, cut[0], cut[1]

@@ -89,6 +89,8 @@ def measure_columns(
     reach = round(2 * half) + 4
     edges = []
     for y_c, is_red in ((rows.red_y_px, True), (rows.blue_y_px, False)):
+        if c.hidden_band == ("red" if is_red else "blue"):  # partly hidden (its robot's mast): its limb may be the mast
+            continue
         y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
         x0, x1 = (rx - 4, rx + rw + reach) if cut_left else (rx - reach, rx + rw + 4)
         tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=thin_step(y1 - y0))

@@ -164,9 +164,9 @@ def candidates(
         hb, w_exp = band_k * gap, width_k * gap
         red_merged = med_r > MERGED * hb + 1
         blue_merged = med_b > MERGED * hb + 1
-        seen, hidden = 1.0, ""
-        if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):
-            c0f, c1f, seen, hidden = extend_along_bands(frag, red, blue, band_k, width_k)  # a body hidden, bands whole
+        seen, hidden, ext_l, ext_r = 1.0, "", False, False
+        if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):  # a body hidden, bands whole
+            c0f, c1f, seen, hidden, ext_l, ext_r = extend_along_bands(frag, red, blue, band_k, width_k)
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0
         ratio = n / w_exp
@@ -186,8 +186,8 @@ def candidates(
         reach = 1 + round(0.08 * w_exp)
         for q, (p0, p1) in enumerate(pieces):
             c0, c1 = round(p0), round(p1)
-            left = q > 0 or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
-            right = (q < len(pieces) - 1 or _continues(red, rrows, c1 - 1 + reach)
+            left = q > 0 or ext_l or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
+            right = (q < len(pieces) - 1 or ext_r or _continues(red, rrows, c1 - 1 + reach)
                      or _continues(blue, brows, c1 - 1 + reach))
             rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
             bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
