@@ -51,6 +51,24 @@ def excess(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray]:
     return r - 0.5 * (g + b), b - 0.5 * (r + g)
 
 
+# BT.601's luma weights (B, G, R): a chroma change that keeps a pixel's luma Y' (colour denoise, 4:2:0)
+# changes this sum of the linear channels only to second order where the pixel is neutral (the white body)
+LUMA_WEIGHTS = (0.114, 0.587, 0.299)
+
+
+def excess_luma(tile: np.ndarray, gains: Gains) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`excess` of a BGR uint8 tile and its luma in linear light ``(H, W)`` float32 (unbalanced)."""
+    if tile.size == 0 or tile.ndim != 3:
+        lin = linear_table()[tile]
+        b, g, r = lin[..., 0], lin[..., 1], lin[..., 2]
+    else:
+        b, g, r = np.ascontiguousarray(cv2.LUT(tile, linear_table().reshape(256, 1)).transpose(2, 0, 1))
+    wb, wg, wr = (np.float32(v) for v in LUMA_WEIGHTS)
+    luma = wb * b + wg * g + wr * r
+    b, g, r = b * gains[0], g * gains[1], r * gains[2]
+    return r - 0.5 * (g + b), b - 0.5 * (r + g), luma
+
+
 def _mean(x: np.ndarray) -> float:
     """``float(x.mean())`` of a float32 array, bit for bit, without ``np.mean``'s overhead (it runs per band)."""
     return float(np.float32(float(np.add.reduce(x)) / x.size))
@@ -179,6 +197,52 @@ def _curve_basis(columns: bytes) -> Tuple[np.ndarray, np.ndarray]:
     aa = np.einsum("ij,ij->i", a, a)
     aa.flags.writeable = False
     return a, aa
+
+
+LUMA_REACH_PX = 4  # rows past a band's chroma edge that its luma edge is integrated over
+LUMA_STEP = 0.25  # the luma step at an edge must reach this share of the brighter side's luma
+BLEED_PX = (-0.5, 2.0)  # how far (towards the band) a luma inner edge may lie from the chroma one
+OUTER_BLEED_PX = 2.0  # ... and a luma outer edge, either way
+
+
+def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: bool) -> Optional[float]:
+    """One band edge on the luma profile ``p``, near its chroma edge ``edge`` (profile rows), or
+    ``None`` when the luma shows no clear step there or the two edges lie too far apart.
+
+    ``down``: the band lies above the edge (the red band's inner edge, the blue band's outer
+    one). ``inner``: the edge is the band's own with the white body, which is brighter.
+
+    Luma keeps full resolution through colour denoise and 4:2:0 chroma, which bleed a band's
+    colour across its edges, the more in linear light the brighter the other side: into the
+    white body always (the chroma edge moves into it by up to a pixel or two: L short, range
+    2-5 % long on such a camera), into a light background too. An inner luma edge is taken when
+    it lies 0-2 px from the chroma one towards the band, the way that bleed moves it; an outer
+    one within 2 px either way, when the background's luma differs from the band's. Otherwise
+    (a mast or a nearer robot's part in front of the body, a background of the band's luma) the
+    chroma edge stands.
+    """
+    n = len(p)
+    s = 1 if down else -1
+    d_in = max(1.0, min(0.5 * band_px, float(LUMA_REACH_PX)))
+    a = round(edge - s * d_in)  # inside the band
+    z = round(edge + s * LUMA_REACH_PX)  # beyond the edge
+    core = p[max(0, a - 1) : a + 2] if 0 <= a < n else p[0:0]
+    beyond = p[z : z + BG_ROWS] if down else p[max(0, z - BG_ROWS + 1) : z + 1]
+    if not 0 <= z < n or core.size == 0 or beyond.size < BG_ROWS:
+        return None
+    level, other = _mean(core), _mean(beyond)
+    step = other - level if inner else abs(other - level)
+    if not step > LUMA_STEP * max(other, level):
+        return None
+    found = edge_down(p, a, z, level, other) if down else edge_up(p, a, z, level, other)
+    shift = s * (edge - found)  # towards the band
+    lo, hi = BLEED_PX if inner else (-OUTER_BLEED_PX, OUTER_BLEED_PX)
+    return found if lo <= shift <= hi else None
+
+
+def luma_inner(p: np.ndarray, edge: float, down: bool, band_px: float) -> Optional[float]:
+    """:func:`luma_edge` of a band's inner edge (``down``: the white body lies below it)."""
+    return luma_edge(p, edge, down, band_px, True)
 
 
 LIMB_BLUR_PX = 3  # columns a limb's edge may be spread over (optics, sensor, the ½-resolution search)

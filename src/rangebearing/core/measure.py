@@ -1,7 +1,9 @@
 """Where a candidate's bands are, to a fraction of a pixel: rows from band edges, columns from limbs.
 
 Rows: each band's two edges by the two-level integral of :mod:`.edges`, over
-the landmark's own columns, so a neighbour beside it does not count. A band
+the landmark's own columns, so a neighbour beside it does not count; where the
+camera's colour denoise or 4:2:0 chroma bled the band's colour into the white
+body, the edges are taken from luma, which keeps full resolution. A band
 whose outer edge merges with a same-coloured background, or a blue band whose
 lower part a nearer robot hides, is placed from its inner edge and the white
 body's height instead.
@@ -22,11 +24,12 @@ import numpy as np
 
 from .._compat import frozen
 from .color import Gains
-from .edges import BandEdges, band_rows, excess, mean_along
+from .edges import BandEdges, band_rows, excess_luma, luma_edge, mean_along
 from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_centre, thin_step
 from .structure import Candidate
 from .types import LandmarkGeometry
 
+BLED_PX = 0.25  # a luma inner edge this far from the chroma one shows the camera bleeds chroma
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
 
@@ -129,9 +132,10 @@ def measure_rows_all(
     for o, tile, wgt in zip(offs, tiles, weights):
         stack[o : o + tile.shape[0], : tile.shape[1]] = tile
         wst[o : o + tile.shape[0], : tile.shape[1]] = wgt
-    er_all, eb_all = excess(stack, gains)
+    er_all, eb_all, lu_all = excess_luma(stack, gains)
     er_all *= wst
     eb_all *= wst
+    lu_all *= wst
     out: List[Optional[Rows]] = []
     j = 0
     for c, win in zip(cands, wins):
@@ -139,14 +143,16 @@ def measure_rows_all(
             out.append(None)
             continue
         o, n, m = offs[j], tiles[j].shape[0], tiles[j].shape[1]
-        out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m], column_sigma))
+        out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m], column_sigma,
+                         lu_all[o : o + n, :m]))
         j += 1
     return out
 
 
 def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb: np.ndarray,
-          column_sigma: bool = True) -> Optional[Rows]:
-    """A candidate's :class:`Rows` from its weighted excess tiles (``oy``: the tiles' first frame row)."""
+          column_sigma: bool = True, lu: Optional[np.ndarray] = None) -> Optional[Rows]:
+    """A candidate's :class:`Rows` from its weighted excess tiles and luma tile ``lu``
+    (``oy``: the tiles' first frame row)."""
     white_m = geometry.height_m - 2 * geometry.band_height_m
     band_px = c.white_px * geometry.band_height_m / white_m
     f = 1
@@ -163,6 +169,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     k = 0.5 * geometry.band_height_m / white_m
     if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
         blue = _hidden(blue, _height(red, True) or 2 * k * white)
+    if lu is not None:
+        red, blue, white = _luma_edges(lu.mean(axis=1), red, blue, 2 * k * white)
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
     sigma = float(np.hypot(red.sigma, blue.sigma)) * (1.0 + (2 * k if red.merged or blue.merged else 0.0))
@@ -176,6 +184,34 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         math.nan if red.merged else 2.0 * (red.inner - red.centre) * f,
         math.nan if blue.merged else 2.0 * (blue.centre - blue.inner) * f,
     )
+
+
+def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
+                ) -> Tuple[BandEdges, BandEdges, float]:
+    """The bands with their edges moved to the luma's (:func:`.edges.luma_edge`) where taken.
+
+    Inner edges first: the white body is always brighter than a band. Where a band's inner
+    luma edge lies ``BLED_PX`` or more from its chroma edge the camera bleeds chroma, into a
+    light background too, so the outer edge is taken from luma as well when the background's
+    luma differs from the band's; elsewhere the chroma outer edge stands (a background's own
+    luma steps, a landmark behind, would only add error). A band's centre is the mean of its
+    two edges; a merged band is placed from its inner edge and the white height, so it
+    follows both through the caller's formula.
+    """
+    bands = []
+    for band, down in ((red, True), (blue, False)):
+        inner = luma_edge(p, band.inner, down, band_px, True)
+        bled = inner is not None and abs(inner - band.inner) >= BLED_PX
+        inner = band.inner if inner is None else inner
+        if band.merged:
+            band = dataclasses.replace(band, inner=inner)
+        else:
+            outer = 2.0 * band.centre - band.inner
+            found = luma_edge(p, outer, not down, band_px, False) if bled else None
+            outer = outer if found is None else found
+            band = dataclasses.replace(band, centre=0.5 * (inner + outer), inner=inner)
+        bands.append(band)
+    return bands[0], bands[1], bands[1].inner - bands[0].inner
 
 
 def _height(band: BandEdges, red: bool) -> float:

@@ -1,0 +1,80 @@
+"""Band rows under a camera's colour denoise and 4:2:0 chroma: the inner edges come from luma."""
+
+import cv2
+import numpy as np
+import pytest
+
+from rangebearing.core.edges import excess_luma, luma_inner
+from rangebearing.core.measure import _rows, measure_rows
+from rangebearing.core.structure import Candidate
+from rangebearing.core.types import LandmarkGeometry
+from rangebearing.synth.isp import chroma_denoise, sharpen, subsample_chroma
+
+GEOMETRY = LandmarkGeometry()
+
+
+def _camera(bg, offset_px, scale):
+    """A landmark ``scale`` × (15, 40, 15) px tall on a grey ``bg`` (linear), its edges ``offset_px``
+    below whole rows, blurred by the lens (1 px, linear light), then through the ISP: luma
+    sharpening, colour denoise (1.5 px) and 4:2:0 chroma. Returns the frame, the candidate and
+    the true band spacing L (rows)."""
+    ss, rows = 8, 120
+    y = (np.arange(rows * ss) + 0.5) / ss
+    r0 = 20 + offset_px
+    r1, b0, b1 = r0 + 15 * scale, r0 + 55 * scale, r0 + 70 * scale
+    lin = np.full((rows * ss, 3), bg)
+    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
+    lin[(y >= r1) & (y < b0)] = 0.85
+    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
+    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
+    img[:, :20] = img[:, 60:] = bg
+    img = cv2.GaussianBlur(img, (0, 0), 1.0)
+    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
+    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    band = round(15 * scale)
+    cand = Candidate((20, 20, 40, band), (20, round(20 + 55 * scale), 40, band), 40.0 * scale,
+                     False, False, False, False, 1.0)
+    return subsample_chroma(chroma_denoise(bgr, 1.5)), cand, 55 * scale
+
+
+@pytest.mark.parametrize("scale", [1.0, 0.4])
+def test_luma_edges_undo_the_pull_of_chroma_bleed_on_the_band_spacing(scale):
+    chroma, luma = [], []
+    for bg in (0.05, 0.3, 0.8):
+        for offset in (0.0, 0.5):
+            img, cand, spacing = _camera(bg, offset, scale)
+            er, eb, lu = excess_luma(img[:, 33:47], (1.0, 1.0, 1.0))
+            a, b = _rows(cand, GEOMETRY, 0, er, eb), _rows(cand, GEOMETRY, 0, er, eb, lu=lu)
+            chroma.append(a.blue_y_px - a.red_y_px - spacing)
+            luma.append(b.blue_y_px - b.red_y_px - spacing)
+    # the chroma edges alone put the bands closer together (range long); luma keeps L within ~0.2 px
+    assert np.mean(chroma) < -0.2
+    assert abs(np.mean(luma)) < 0.1 and np.mean(np.abs(luma)) < 0.5 * np.mean(np.abs(chroma))
+
+
+def test_measure_rows_keeps_the_band_spacing_and_white_height_through_the_isp():
+    img, cand, spacing = _camera(0.3, 0.3, 1.0)
+    rows = measure_rows(img, cand, (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert rows.blue_y_px - rows.red_y_px == pytest.approx(spacing, abs=0.3)
+    assert rows.white_px == pytest.approx(40.0, abs=0.3)
+
+
+def _luma_profile(edge, band=0.2, white=0.8, n=40):
+    """Band luma above row ``edge`` (sub-pixel, linear mixing), white body below."""
+    cover = np.clip(edge - (np.arange(n) - 0.5), 0.0, 1.0)
+    return (white + (band - white) * cover).astype(np.float32)
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.7, 1.6])
+def test_the_luma_edge_is_taken_when_the_chroma_edge_lies_a_little_into_the_body(offset):
+    p = _luma_profile(20.3)
+    assert luma_inner(p, 20.3 + offset, True, 8.0) == pytest.approx(20.3, abs=1e-4)
+    q = p[::-1].copy()  # the blue band's inner edge: the body above it
+    assert luma_inner(q, 39 - 20.3 - offset, False, 8.0) == pytest.approx(39 - 20.3, abs=1e-4)
+
+
+def test_a_luma_edge_far_from_the_chroma_one_is_not_taken():
+    # a dark mast in front of the body, right below the band: luma steps 3 rows lower than the band ends
+    p = _luma_profile(23.3)
+    assert luma_inner(p, 20.3, True, 8.0) is None
+    assert luma_inner(_luma_profile(20.3, band=0.7), 20.3, True, 8.0) is None  # no luma step at all
