@@ -169,8 +169,12 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     k = 0.5 * geometry.band_height_m / white_m
     if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
         blue = _hidden(blue, _height(red, True) or 2 * k * white)
-    if lu is not None:
-        red, blue, white = _luma_edges(lu.mean(axis=1), red, blue, 2 * k * white)
+    if lu is not None and not (red.merged and blue.merged):
+        l_red, l_blue, l_white = _luma_edges(lu.mean(axis=1), red, blue, 2 * k * white)
+        # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
+        # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
+        if _misfit(l_red, l_blue, l_white, 2 * k) < _misfit(red, blue, white, 2 * k):
+            red, blue, white = l_red, l_blue, l_white
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
     sigma = float(np.hypot(red.sigma, blue.sigma)) * (1.0 + (2 * k if red.merged or blue.merged else 0.0))
@@ -212,6 +216,12 @@ def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
             band = dataclasses.replace(band, centre=0.5 * (inner + outer), inner=inner)
         bands.append(band)
     return bands[0], bands[1], bands[1].inner - bands[0].inner
+
+
+def _misfit(red: BandEdges, blue: BandEdges, white: float, share: float) -> float:
+    """How far the measured bands' heights are from ``share`` (15/40) of the white height, relative."""
+    heights = [h for h in (_height(red, True), _height(blue, False)) if h > 0]
+    return abs(sum(heights) / max(len(heights), 1) / max(share * white, 1e-6) - 1.0)
 
 
 def _height(band: BandEdges, red: bool) -> float:
