@@ -29,6 +29,7 @@ from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_cent
 from .structure import Candidate
 from .types import LandmarkGeometry
 
+MISFIT_SLACK = 0.05  # the luma may spoil the proportion by this much (band heights' own scatter)
 BLED_PX = 0.25  # a luma inner edge this far from the chroma one shows the camera bleeds chroma
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
@@ -173,7 +174,7 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         l_red, l_blue, l_white = _luma_edges(lu.mean(axis=1), red, blue, 2 * k * white)
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
-        if _misfit(l_red, l_blue, l_white, 2 * k) < _misfit(red, blue, white, 2 * k):
+        if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
             red, blue, white = l_red, l_blue, l_white
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
