@@ -171,7 +171,7 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
         blue = _hidden(blue, _height(red, True) or 2 * k * white)
     if lu is not None and not (red.merged and blue.merged):
-        l_red, l_blue, l_white = _luma_edges(lu.mean(axis=1), red, blue, 2 * k * white)
+        l_red, l_blue, l_white = _luma_edges(mean_along(lu, 1), red, blue, 2 * k * white)
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
         if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
