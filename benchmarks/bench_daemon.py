@@ -282,7 +282,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                   f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "
                   f"| {d.cpu_ms_per_frame - d.pipeline_cpu_ms:.3f} "
                   f"| {d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / {d.latency_ms_max:.2f} "
-                  f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} (clip {d.clip_mib:.0f} in page cache) | {os.getloadavg()[0]:.2f} |",
+                  f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} (clip {d.clip_mib:.0f} in page cache) "
+                  f"| {os.getloadavg()[0]:.2f} |",
                   flush=True)
     return 0
 

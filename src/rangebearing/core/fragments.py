@@ -60,9 +60,9 @@ def height_steps(e1: np.ndarray, e2: np.ndarray, width_k: float, depth: int = 2)
         left, right = cs[c] / c, (cs[n] - cs[c]) / (n - c)
         score += c * (n - c) / n * (left - right) ** 2
     k = int(c[int(np.argmax(score))])
-    gl, gr = float(np.median(g[:k])), float(np.median(g[k:]))
-    steps = (abs(gl - gr), abs(float(np.median(e1[:k]) - np.median(e1[k:]))),
-             abs(float(np.median(e2[:k]) - np.median(e2[k:]))))
+    gl, gr = float(median(g[:k])), float(median(g[k:]))
+    steps = (abs(gl - gr), abs(median(e1[:k]) - median(e1[k:])),
+             abs(median(e2[:k]) - median(e2[k:])))
     tall, (t0, t1) = (gl, (0, k)) if gl >= gr else (gr, (k, n))
     if n <= WIDE * width_k * tall or max(steps) < STEP_PX:
         return [(0, n)]
@@ -97,8 +97,8 @@ def split_runs(
         return list(found)
     out: List[Tuple[int, int]] = []
     for (r0, r1), look in zip(found, wide.tolist()):
-        hb = band_k * float(np.median(g[r0:r1])) if look else 0.0
-        if not look or max(float(np.median(run_r[r0:r1])), float(np.median(run_b[r0:r1]))) > merged_k * hb + 1:
+        hb = band_k * float(median(g[r0:r1])) if look else 0.0
+        if not look or max(float(median(run_r[r0:r1])), float(median(run_b[r0:r1]))) > merged_k * hb + 1:
             out.append((r0, r1))
             continue
         out.extend((r0 + a, r0 + b) for a, b in height_steps(e1[r0:r1], e2[r0:r1], width_k))
