@@ -34,3 +34,10 @@ def test_report_by_hand():
     assert report.detection_rate == 0.5
     assert report.range_err_pct_mean == pytest.approx(1.0)
     assert "detected          1 (50.0 %)" in format_report(report)
+
+
+def test_report_says_so_when_the_truth_has_no_visible_share():
+    report, _ = accuracy([("a", [lm(0.505, 0.0)], [TruthRow("a", 0.5, 0.0)])])
+    assert math.isnan(report.visible_err_mean)
+    line = [ln for ln in format_report(report).splitlines() if ln.startswith("visible error")]
+    assert line == ["visible error     - (the truth gives no visible share)"]

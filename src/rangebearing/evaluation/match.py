@@ -168,6 +168,8 @@ def format_report(rep: AccuracyReport) -> str:
             f"bearing error     mean {rep.bearing_err_deg_mean:.3f}°  p95 {rep.bearing_err_deg_p95:.3f}°",
             f"sigma coverage    |err| <= 2 sigma: range {100.0 * rep.range_cover:.1f} %   "
             f"bearing {100.0 * rep.bearing_cover:.1f} %",
-            f"visible error     mean {rep.visible_err_mean:.3f}   p95 {rep.visible_err_p95:.3f}",
+            f"visible error     mean {rep.visible_err_mean:.3f}   p95 {rep.visible_err_p95:.3f}"
+            if math.isfinite(rep.visible_err_mean)
+            else "visible error     - (the truth gives no visible share)",
         ]
     )
