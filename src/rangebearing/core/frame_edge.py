@@ -17,6 +17,7 @@ import numpy as np
 from .color import Gains
 from .edges import excess, limb, linear_table
 from .limbs import FRAME_EDGE_PX, _tile, thin_step
+from .stats import median
 from .structure import MIN_VISIBLE, Candidate
 from .types import BBox, LandmarkGeometry
 
@@ -72,7 +73,7 @@ def edge_run(
     er, _ = excess(tile, gains)
     q = (er / np.maximum(linear_table()[tile].sum(axis=2), 1e-3)).mean(axis=0)
     core = max(0, min(n - 1, round(core_x_px) - ox))
-    level = float(np.median(q[max(0, core - 2) : core + 3]))
+    level = median(q[max(0, core - 2) : core + 3])
     left, right = limb(q, core, 0, level), limb(q, core, n - 1, level)
     at_left = ox == 0 and not np.isfinite(left)
     at_right = ox + n == w and not np.isfinite(right)
