@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rangebearing.daemon.stats import LoopStats, _percentile
+from rangebearing.core.stats import percentile
+from rangebearing.daemon.stats import LoopStats
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 7, 100, 4096])
@@ -14,7 +15,7 @@ def test_percentiles_are_numpys(n: int) -> None:
     for _ in range(20):
         x = rng.integers(0, 10**8, n)
         for pct in (0, 37.5, 50, 99, 99.9, 100):
-            assert _percentile(np.sort(x) / 1e6, pct) == float(np.percentile(x / 1e6, pct))
+            assert percentile(np.sort(x) / 1e6, pct) == float(np.percentile(x / 1e6, pct))
 
 
 def test_summary_figures() -> None:

@@ -10,6 +10,8 @@ input's float type, or in float64 for integers, as ``np.mean`` computes it), NaN
 
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 
@@ -50,3 +52,24 @@ def median_rows(values: np.ndarray) -> np.ndarray:
     if nan_check:
         out[np.isnan(part[n - 1])] = np.nan
     return out
+
+
+def percentile(values: np.ndarray, pct: float, table: Optional[np.ndarray] = None) -> float:
+    """``np.percentile(values, pct)`` (its default, linear method) by a partial sort.
+
+    Two order statistics and their linear interpolation: the same value as numpy's,
+    without its generic path (tens of microseconds a call: verify takes four per candidate,
+    the daemon two per status line).
+    ``table``: a non-decreasing lookup table; the percentile is then that of
+    ``table[values]``, for which only the two order statistics need looking up
+    (a non-decreasing map keeps every order statistic).
+    """
+    part = values.flatten()  # a copy to partition in place: np.partition's own steps, minus its wrapper
+    pos = pct / 100.0 * (part.size - 1)
+    lo = int(pos)
+    hi = min(lo + 1, part.size - 1)
+    part.partition((lo, hi))
+    low, high = (part[lo], part[hi]) if table is None else (table[part[lo]], table[part[hi]])
+    low, high = float(low), float(high)
+    t = pos - lo
+    return high - (high - low) * (1.0 - t) if t >= 0.5 else low + (high - low) * t

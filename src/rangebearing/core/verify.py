@@ -64,6 +64,7 @@ from .detect import BandCentroids
 from .edges import linear_table
 from .model import normalised
 from .params import ModelParams
+from .stats import percentile
 from .types import CameraIntrinsics, LandmarkGeometry
 
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
@@ -122,26 +123,6 @@ def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, flo
         if not all(_same(own, _colour(bgr, rows, side)) for side in sides):
             return False
     return True
-
-
-def percentile(values: np.ndarray, pct: float, table: Optional[np.ndarray] = None) -> float:
-    """``np.percentile(values, pct)`` (its default, linear method) by a partial sort.
-
-    Two order statistics and their linear interpolation: the same value as numpy's,
-    without its generic path (tens of microseconds a call, four calls per candidate).
-    ``table``: a non-decreasing lookup table; the percentile is then that of
-    ``table[values]``, for which only the two order statistics need looking up
-    (a non-decreasing map keeps every order statistic).
-    """
-    part = values.flatten()  # a copy to partition in place: np.partition's own steps, minus its wrapper
-    pos = pct / 100.0 * (part.size - 1)
-    lo = int(pos)
-    hi = min(lo + 1, part.size - 1)
-    part.partition((lo, hi))
-    low, high = (part[lo], part[hi]) if table is None else (table[part[lo]], table[part[hi]])
-    low, high = float(low), float(high)
-    t = pos - lo
-    return high - (high - low) * (1.0 - t) if t >= 0.5 else low + (high - low) * t
 
 
 def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
