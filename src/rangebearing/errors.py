@@ -33,6 +33,10 @@ class FrameError(RangeBearingError, ValueError):
     """A frame is unusable (wrong shape, wrong dtype, empty, corrupt)."""
 
 
+class DetectorFault(FrameError):
+    """The detector failed on one frame (a defect, not a bad frame): that frame is skipped, the run goes on."""
+
+
 class FrameShapeError(FrameError):
     """Frames of a size the configuration cannot serve (another aspect ratio than camera.*): every frame would fail."""
 

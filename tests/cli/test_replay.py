@@ -51,3 +51,23 @@ def test_lens_distortion_is_undone_before_the_model():
 def test_synth_writes_the_camera_it_rendered_with(tmp_path):
     write_dataset(tmp_path / "d", 2, 1, "paper", camera=CameraIntrinsics(distortion=(-0.2, 0.0, 0.0, 0.0, 0.0)))
     assert load_config(tmp_path / "d" / "camera.yaml").camera.distortion[0] == -0.2
+
+
+def test_replay_skips_and_counts_a_frame_the_detector_fails_on(tmp_path, static_clip, monkeypatch, capsys):
+    from rangebearing.cli.main import main
+    from rangebearing.core.pipeline import Pipeline
+
+    real, calls = Pipeline.process, []
+
+    def broken_on_the_second(self, frame, t_s=None, search=None):
+        calls.append(1)
+        if len(calls) == 2:
+            raise ValueError("operands could not be broadcast together")
+        return real(self, frame, t_s=t_s, search=search)
+
+    monkeypatch.setattr(Pipeline, "process", broken_on_the_second)
+    out = tmp_path / "r.jsonl"
+    assert main(["replay", str(static_clip), "-q", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "skipped: detector failed on this frame (ValueError at" in err and "1 frame(s) skipped" in err
+    assert len(out.read_text().splitlines()) == len(calls) - 1

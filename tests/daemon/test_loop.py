@@ -340,3 +340,27 @@ def test_run_never_leaves_the_collector_off(tmp_path):
     assert gc.isenabled()
     assert main(["run", "--config", str(bad)]) != 0  # refused before any frame
     assert gc.isenabled()
+
+
+def test_a_detector_defect_on_one_frame_is_skipped_counted_and_logged_with_its_traceback(static_clip, monkeypatch,
+                                                                                         caplog):
+    from rangebearing.core.pipeline import Pipeline
+
+    real, calls = Pipeline.process, []
+
+    def sometimes_broken(self, frame, t_s=None, search=None):
+        calls.append(1)
+        if len(calls) in (3, 7):
+            raise IndexError("index 9 is out of bounds for axis 0 with size 9")
+        return real(self, frame, t_s=t_s, search=search)
+
+    monkeypatch.setattr(Pipeline, "process", sometimes_broken)
+    pub = MemoryPublisher()
+    daemon = Daemon(recorded_cfg(static_clip), opener, lambda cfg: pub, RecordingNotifier())
+    with caplog.at_level("WARNING"):
+        assert daemon.run() == 0
+    assert daemon.stats.bad_frames == 2 and len(pub.payloads) == 10
+    for p in pub.payloads:
+        assert_matches_static_truth(p)
+    faults = [r for r in caplog.records if "detector failed" in r.getMessage()]
+    assert len(faults) == 2 and all(r.exc_info and r.exc_info[0] is IndexError for r in faults)

@@ -14,6 +14,7 @@ from typing import Any, Iterator
 import cv2
 
 from ..config import Config, check
+from ..core.guarded import process_or_skip
 from ..core.pipeline import Pipeline
 from ..errors import ConfigError, FrameError, OutputError, ProtocolError, RangeBearingError
 from ..net.protocol import encode_reading, wire_time_ns
@@ -72,9 +73,9 @@ class _Mcap:
         self.rec.write_image(frame.image, t_ns, frame.index)
         if self.pipe is not None:
             try:
-                landmarks = self.pipe.process(frame.image).landmarks
+                landmarks = process_or_skip(self.pipe, frame.image).landmarks
                 self.rec.write_reading(encode_reading(self.robot, n, t_unix, landmarks), t_ns)
-            except (FrameError, ProtocolError) as exc:
+            except (FrameError, ProtocolError) as exc:  # a detector defect too (DetectorFault): the image is kept
                 print(f"no reading for frame {n}: {exc}", file=sys.stderr)
 
     def close(self) -> None:

@@ -10,6 +10,7 @@ from typing import Any, List, Tuple, Union
 
 import cv2
 
+from ..core.guarded import process_or_skip
 from ..core.pipeline import Pipeline
 from ..core.types import Landmark
 from ..errors import FrameError, OutputError, SourceError
@@ -67,8 +68,8 @@ def run(args: argparse.Namespace) -> int:
             try:
                 if image is None:
                     raise FrameError("unreadable image")
-                result = pipe.process(image)
-            except FrameError as exc:
+                result = process_or_skip(pipe, image)
+            except FrameError as exc:  # a bad frame, or a detector defect on it (DetectorFault): skipped, counted
                 bad += 1
                 print(f"{name}: skipped: {exc}", file=sys.stderr)
                 continue
@@ -98,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         if out:
             out.close()  # renamed into place: the lines so far, also when interrupted
     if bad:
-        print(f"{bad} frame(s) skipped as unreadable", file=sys.stderr)
+        print(f"{bad} frame(s) skipped (unreadable, or the detector failed on them)", file=sys.stderr)
     if truth is not None:
         if not evaluated:
             raise SourceError(f"no frames of {path} could be evaluated")

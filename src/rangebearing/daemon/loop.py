@@ -1,17 +1,15 @@
 """The capture loop behind ``rangebearing run``: frames in, UDP readings out.
 
-Short wiring over the library: a :class:`~rangebearing.sources.base.FrameSource`,
-a :class:`~rangebearing.core.pipeline.Pipeline` and a
-:class:`~rangebearing.net.publisher.Publisher`, all passed in; systemd's
-READY/WATCHDOG/STATUS live in :mod:`.housekeeping`. The loop always takes the
-source's newest frame (the source counts what it skipped), skips and counts
-bad frames, never lets a network fault through, and on SIGHUP swaps in the
-config that the injected ``reload`` returns, between frames; a reload can
-never end the daemon. Camera faults are ridden out by :mod:`.capture`.
+Short wiring over the library: a :class:`~rangebearing.sources.base.FrameSource`, a
+:class:`~rangebearing.core.pipeline.Pipeline` and a :class:`~rangebearing.net.publisher.Publisher`, all passed
+in; systemd's READY/WATCHDOG/STATUS live in :mod:`.housekeeping`. The loop always takes the source's newest
+frame (the source counts what it skipped), skips and counts bad frames and frames the detector fails on, never
+lets a network fault through, and on SIGHUP swaps in the config that the injected ``reload`` returns, between
+frames; a reload can never end the daemon. Camera faults are ridden out by :mod:`.capture`.
 
-Exit status: 0 for the end of a recording or a requested stop (SIGTERM at any
-moment, camera back-off included), 1 when the camera is gone past its budget,
-2 when the frames cannot fit the configuration (another aspect ratio).
+Exit status: 0 for the end of a recording or a requested stop (SIGTERM at any moment, camera back-off
+included), 1 when the camera is gone past its budget, 2 when the frames cannot fit the configuration (another
+aspect ratio).
 """
 
 from __future__ import annotations
@@ -26,6 +24,7 @@ from typing import TYPE_CHECKING, Callable, Optional
 
 from .. import _signals
 from ..config import Config
+from ..core.guarded import DetectorFault, process_or_skip
 from ..core.pipeline import Pipeline
 from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
 from ..net.fit import encode_fitting
@@ -182,7 +181,7 @@ class Daemon:
                         log.info("end of stream")
                     return 0
                 t0, c0 = clock(), thread_cpu()
-                result = self._pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
+                result = process_or_skip(self._pipe, frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
                 t1, c1 = clock(), thread_cpu()
                 pub = self.cfg.publish
                 t_unix = _unix_time(frame, t1)
@@ -238,11 +237,11 @@ class Daemon:
 
     def _bad_frame(self, exc: Exception) -> None:
         """Count a skipped frame; log the first three, then every hundredth (no flooding the journal)."""
-        self.stats.bad_frames += 1
-        n = self.stats.bad_frames
+        self.stats.bad_frames = n = self.stats.bad_frames + 1
         if n <= 3 or n % 100 == 0:
             what = "reading not encodable, frame skipped" if isinstance(exc, ProtocolError) else "bad frame skipped"
-            log.warning("%s (%d so far): %s", what, n, exc)
+            bug = exc.__cause__ if isinstance(exc, DetectorFault) else None  # a defect's traceback goes to the journal
+            log.warning("%s (%d so far): %s", what, n, exc, exc_info=bug)
 
     def _do_reload(self) -> None:
         """Swap in the reloaded config; keep everything as it was if the new one is bad.
