@@ -39,6 +39,21 @@ def test_a_smaller_frame_of_the_same_camera_reads_the_same():
     assert b.bearing_rad == pytest.approx(a.bearing_rad, abs=0.002)
 
 
+def test_a_change_of_frame_size_mid_run_starts_the_tracks_again_with_new_ids():
+    import cv2
+
+    img = render(SCENE)
+    pipe = Pipeline(load_config(None).pipeline, track=True)
+    first = pipe.process(img).landmarks
+    assert pipe.process(img).tracked  # the second frame follows the landmark
+    for size in ((80, 60), (1280, 960), (640, 480)):  # tracks of another size would point outside the frame
+        got = pipe.process(cv2.resize(img, size, interpolation=cv2.INTER_AREA))
+        assert not got.tracked
+    again = pipe.process(img).landmarks
+    assert again[0].range_m == pytest.approx(first[0].range_m, rel=0.01)
+    assert again[0].track_id > first[0].track_id  # ids are never reused
+
+
 def test_readings_with_no_positive_range_are_dropped():
     cfg = load_config(None)
     broken = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, c_m=-0.5))

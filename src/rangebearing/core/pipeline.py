@@ -98,6 +98,7 @@ class Pipeline:
         self._sides: SideCounts = (0, 0)
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
+        self._size: Optional[Tuple[int, int]] = None  # the frame size the tracks were found in
 
     def _camera(self, w: int, h: int) -> Tuple[CameraIntrinsics, int]:
         """Intrinsics for this frame size and the band-preserving filter size."""
@@ -131,6 +132,9 @@ class Pipeline:
         """
         bgr = check_frame(frame)
         h, w = bgr.shape[:2]
+        if (w, h) != self._size:  # another frame size (a camera reconfigured, mixed recordings): tracks start again
+            self.reset()
+            self._size = (w, h)
         cam, ksize = self._camera(w, h)
         det = self.params.detection
         tracked = False
