@@ -81,6 +81,19 @@ def test_chroma_blur_is_the_colours_blur_beyond_the_brightness():
     assert u.chroma_blur_px(np.zeros((6, 6, 3), np.uint8), (3.0, 1.0), (3.0, 4.0), 2.0, (1.0, 1.0, 1.0)) == 0.0
 
 
+def test_chroma_blur_of_all_landmarks_at_once_is_each_ones_own():
+    """Stacking the landmarks' tiles changes no value: the batch gives each landmark's blur bit for bit,
+    a landmark too small to measure gives 0 in its place."""
+    a, b = _landmark_columns(0.8), _landmark_columns(1.6)
+    frame = np.concatenate((a, np.full((100, 13, 3), 90, np.uint8), b), axis=1)  # two landmarks, 53 px apart
+    bands = [((20.0, 17.0), (20.0, 72.0), 30.0), ((2.0, 1.0), (2.0, 4.0), 2.0), ((73.0, 17.0), (73.0, 72.0), 24.0)]
+    gains = (1.1, 1.0, 0.9)
+    each = [u.chroma_blur_px(frame, r, bl, w, gains) for r, bl, w in bands]
+    assert u.chroma_blur_all(frame, bands, gains) == each
+    assert each[1] == 0.0 and 0.0 < each[0] < each[2]
+    assert u.chroma_blur_all(frame, [], gains) == []
+
+
 def test_pipeline_readings_carry_sigmas_that_grow_with_sensor_noise():
     cfg = Config()
     clean = Scene(landmarks=(LandmarkPose(0.8, 0.1),))

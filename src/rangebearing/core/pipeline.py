@@ -35,7 +35,7 @@ from .scans import crossing, rescanned
 from .structure import Candidate
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
-from .uncertainty import chroma_blur_px, reading_sigma
+from .uncertainty import chroma_blur_all, chroma_blur_px, reading_sigma
 from .verify import verified
 from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
 
@@ -176,10 +176,9 @@ class Pipeline:
                 # no landmark without a landmark's properties, nor away from where landmarks stand
                 found = verified(bgr, found, self.params.landmark, self.params.model, cam)
                 found = drop_stacked(found)  # nor one standing under another (that robot's body)
-                if self.track:  # the colour's blur, measured once here and kept by the tracked frames after it
-                    found = [dataclasses.replace(c, chroma_blur_px=chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px,
-                                                                                  c.width_px, self._gains))
-                             for c in found]
+                # the colour's blur, of all landmarks at once; tracked frames keep it (see _reading)
+                blurs = chroma_blur_all(bgr, [(c.red_xy_px, c.blue_xy_px, c.width_px) for c in found], self._gains)
+                found = [dataclasses.replace(c, chroma_blur_px=b) for c, b in zip(found, blurs)]
                 if self.track:
                     self._hidden = still_hidden([*self._tracks, *self._lost], self._hidden, found, det.full_scan_every)
                 self._tracks = rescanned(self._tracks, found, self._lost) if self.track else []

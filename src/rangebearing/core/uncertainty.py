@@ -47,12 +47,12 @@ one's); ``docs/detection.md`` lists the known ones.
 from __future__ import annotations
 
 import math
-from typing import Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .color import Gains
-from .edges import excess, linear_table
+from .edges import excess_luma, mean_along
 
 # range: terms of the band spacing's error (px), each in quadrature
 NOISE_SHARE = 0.5  # column-scatter standard error of the inner edges → the spacing
@@ -83,15 +83,24 @@ def _edge_width(p: np.ndarray, at: float, rising: bool) -> float:
     if hi - lo < 3:
         return math.nan
     d = np.diff(p[lo : hi + 1]) if rising else -np.diff(p[lo : hi + 1])
-    j = int(np.argmax(d))
+    dl = d.tolist()
+    j = dl.index(max(dl))  # np.argmax: the first largest
+    dl = dl[max(0, j - EDGE_HALF_PX) : j + EDGE_HALF_PX + 1]
     d = d[max(0, j - EDGE_HALF_PX) : j + EDGE_HALF_PX + 1]
-    d = np.clip(d - max(0.0, float(min(d[0], d[-1]))), 0.0, None)  # a shading slope under the step is no edge
-    total = float(d.sum())
+    d = np.maximum(d - max(0.0, min(dl[0], dl[-1])), 0.0)  # a shading slope under the step is no edge
+    total = float(d.sum())  # the profile's dtype, as numpy sums it
     if total <= 1e-9:
         return math.nan
-    x = np.arange(len(d), dtype=np.float64)
-    m = float(x @ d) / total
-    return math.sqrt(max(float(((x - m) ** 2) @ d) / total, 0.0))
+    # the moments in Python on at most 7 rows: a numpy dot of this size sums in this order too
+    dl = d.tolist()
+    first = 0.0
+    for k, v in enumerate(dl):
+        first += k * v
+    m = first / total
+    second = 0.0
+    for k, v in enumerate(dl):
+        second += (k - m) * (k - m) * v
+    return math.sqrt(max(second / total, 0.0))
 
 
 def chroma_blur_px(
@@ -109,24 +118,61 @@ def chroma_blur_px(
     two bands. Luma sharpening narrows the luma edge, which counts as colour blur too:
     the colour planes are not sharpened.
     """
-    h, w = bgr.shape[:2]
+    return chroma_blur_all(bgr, [(red_xy_px, blue_xy_px, width_px)], gains)[0]
+
+
+BlurWindow = Tuple[int, int, int, int, float, float]  # y0, y1, x0, x1 and the two inner edges' rows in it
+
+
+def _blur_window(shape: Tuple[int, ...], red_xy_px: Tuple[float, float], blue_xy_px: Tuple[float, float],
+                 width_px: float) -> Optional[BlurWindow]:
+    """The frame region :func:`chroma_blur_px` reads and the inner edges' rows in it; ``None`` when too small."""
+    h, w = shape[:2]
     x = 0.5 * (red_xy_px[0] + blue_xy_px[0])
     x0, x1 = int(max(0, x - width_px / 3)), int(min(w, x + width_px / 3 + 1))
     y_r, y_b = red_xy_px[1], blue_xy_px[1]
     half = 0.5 * BAND_SHARE * (y_b - y_r)
     y0, y1 = int(max(0, y_r + half - EDGE_WINDOW_PX - 2)), int(min(h, y_b - half + EDGE_WINDOW_PX + 3))
     if x1 <= x0 or y1 - y0 < 8:
-        return 0.0
-    tile = bgr[y0:y1, x0:x1]
-    er, eb = excess(tile, gains)
-    lin = linear_table()[tile]
-    luma = (0.114 * lin[..., 0] + 0.587 * lin[..., 1] + 0.299 * lin[..., 2]).mean(axis=1)
-    blur2 = []
-    for p, at, colour_rises in ((er.mean(axis=1), y_r + half - y0, False), (eb.mean(axis=1), y_b - half - y0, True)):
-        wc, wl = _edge_width(p, at, colour_rises), _edge_width(luma, at, not colour_rises)
-        if math.isfinite(wc) and math.isfinite(wl):
-            blur2.append(max(0.0, wc * wc - wl * wl))
-    return math.sqrt(sum(blur2) / len(blur2)) if blur2 else 0.0
+        return None
+    return y0, y1, x0, x1, y_r + half - y0, y_b - half - y0
+
+
+def chroma_blur_all(bgr: np.ndarray, bands: Sequence[Tuple[Tuple[float, float], Tuple[float, float], float]],
+                    gains: Gains) -> List[float]:
+    """:func:`chroma_blur_px` of every ``(red_xy_px, blue_xy_px, width_px)`` of a frame, the same values.
+
+    The landmarks' tiles are stacked one below the other, so the conversion to linear-light
+    excess and luma runs once for all of them (it is per pixel: stacking changes no value);
+    each tile's column means are then taken over its own columns only.
+    """
+    wins = [_blur_window(bgr.shape, r, b, w) for r, b, w in bands]
+    live = [win for win in wins if win is not None]
+    if not live:
+        return [0.0] * len(wins)
+    offs = np.cumsum([0] + [win[1] - win[0] for win in live]).tolist()
+    stack = np.zeros((offs[-1], max(win[3] - win[2] for win in live), 3), np.uint8)
+    for o, (y0, y1, x0, x1, _, _) in zip(offs, live):
+        stack[o : o + y1 - y0, : x1 - x0] = bgr[y0:y1, x0:x1]
+    er_all, eb_all, lu_all = excess_luma(stack, gains)
+    out: List[float] = []
+    j = 0
+    for win in wins:
+        if win is None:
+            out.append(0.0)
+            continue
+        y0, y1, x0, x1, at_r, at_b = win
+        rows, m = slice(offs[j], offs[j] + y1 - y0), x1 - x0
+        j += 1
+        luma = mean_along(lu_all[rows, :m], 1)
+        blur2 = []
+        for p, at, colour_rises in ((mean_along(er_all[rows, :m], 1), at_r, False),
+                                    (mean_along(eb_all[rows, :m], 1), at_b, True)):
+            wc, wl = _edge_width(p, at, colour_rises), _edge_width(luma, at, not colour_rises)
+            if math.isfinite(wc) and math.isfinite(wl):
+                blur2.append(max(0.0, wc * wc - wl * wl))
+        out.append(math.sqrt(sum(blur2) / len(blur2)) if blur2 else 0.0)
+    return out
 
 
 def row_spread_px(
