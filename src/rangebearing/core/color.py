@@ -57,18 +57,25 @@ def grey_world_gains(bgr: np.ndarray, limit: float = 2.0) -> Gains:
     tiny = cv2.resize(bgr, (max(1, w // f), max(1, h // f)), interpolation=cv2.INTER_AREA) if f > 1 else bgr
     pixels = tiny.reshape(-1, 3).astype(np.float32)
     gains = np.ones(3, np.float64)
+    unbalanced = None  # the weighted mean colour of the frame as it is, once measured
     # (numpy's values throughout, without the Python layers of np.clip, .mean() and .sum() on 3 numbers)
     for _ in range(BALANCE_ITERATIONS):
         g = gains.tolist()
         q = apply_gains(tiny, tuple(g)) if g != [1.0, 1.0, 1.0] else tiny
-        _, s, v = cv2.split(cv2.cvtColor(q, cv2.COLOR_BGR2HSV))
-        # weight: neutral-ness from S (after the gains), zero for dark or clipped V (one table each)
-        wgt = cv2.multiply(cv2.LUT(s, _neutral_table()), cv2.LUT(v, _valid_table()), scale=1.0 / 255.0)
-        wv = wgt.reshape(-1).astype(np.float32)
-        total = float(np.add.reduce(wv))
-        if total < 1e-3 * 255.0 * len(wv):  # nothing near neutral: keep what we have
-            break
-        mean = (wv @ pixels) / total * gains  # the balanced colour of the neutral surfaces
+        if q is tiny and unbalanced is not None:  # gains too near one to change a pixel: the same weights again
+            mean = unbalanced * gains
+        else:
+            _, s, v = cv2.split(cv2.cvtColor(q, cv2.COLOR_BGR2HSV))
+            # weight: neutral-ness from S (after the gains), zero for dark or clipped V (one table each)
+            wgt = cv2.multiply(cv2.LUT(s, _neutral_table()), cv2.LUT(v, _valid_table()), scale=1.0 / 255.0)
+            wv = wgt.reshape(-1).astype(np.float32)
+            total = float(np.add.reduce(wv))
+            if total < 1e-3 * 255.0 * len(wv):  # nothing near neutral: keep what we have
+                break
+            weighted = (wv @ pixels) / total
+            if q is tiny:
+                unbalanced = weighted
+            mean = weighted * gains  # the balanced colour of the neutral surfaces
         gains = np.minimum(np.maximum(gains * (np.add.reduce(mean) / 3) / np.maximum(mean, 1e-3), 1.0 / limit), limit)
     return tuple(gains.tolist())  # type: ignore[return-value]
 

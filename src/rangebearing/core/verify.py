@@ -90,7 +90,7 @@ def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]
     return percentile(bgr[r0:r1:rs, c0:c1:cs, channel], pct, linear_table())
 
 
-def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[np.ndarray]:
+def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[List[float]]:
     """Linear RGB (B, G, R order) of a region's mean 8-bit colour, ``None`` when the region is empty."""
     h, w = bgr.shape[:2]
     r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
@@ -98,11 +98,15 @@ def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float
     if r1 <= r0 or c1 <= c0:
         return None
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
-    return (bgr[r0:r1:rs, c0:c1:cs].mean(axis=(0, 1)) / 255.0) ** 2.2
+    sub = bgr[r0:r1:rs, c0:c1:cs]
+    n = sub.shape[0] * sub.shape[1]
+    # the channel sums are exact integers: the mean's values (np.mean's float sum) in three Python floats
+    return [(total / n / 255.0) ** 2.2 for total in np.add.reduce(sub, axis=(0, 1), dtype=np.int64).tolist()]
 
 
-def _same(a: Optional[np.ndarray], b: Optional[np.ndarray]) -> bool:
-    return a is not None and b is not None and bool(np.all(np.abs(np.log((a + 0.01) / (b + 0.01))) <= SAME_COLOUR_LOG))
+def _same(a: Optional[List[float]], b: Optional[List[float]]) -> bool:
+    return a is not None and b is not None and all(
+        abs(math.log((x + 0.01) / (y + 0.01))) <= SAME_COLOUR_LOG for x, y in zip(a, b))
 
 
 def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, float]],
@@ -115,8 +119,11 @@ def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, flo
     x, _, w, _ = c.bbox_px
     near, far = SIDE_REACH[0] * w, SIDE_REACH[1] * w
     sides = ((x - far, x - near), (x + w + near, x + w + far))
-    if any(o is not c and o.bbox_px[0] < hi and o.bbox_px[0] + o.bbox_px[2] > lo for o in others for lo, hi in sides):
-        return False
+    for o in others:
+        if o is not c:
+            ox, _, ow, _ = o.bbox_px  # (a property: computed once per other candidate)
+            if any(ox < hi and ox + ow > lo for lo, hi in sides):
+                return False
     # body first: beside most real landmarks it is the background, and one differing layer ends the test
     for rows in reversed(layers):
         own = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
