@@ -125,3 +125,41 @@ def test_controls_lock_exposure_and_white_balance_a_few_frames_later(fake_picame
     with pytest.raises(RuntimeError, match="not advertised"):
         cam.set_controls({"Bogus": 1})
     cam.close()
+
+
+@pytest.mark.parametrize("wait, signal", [(False, None), (0, None), (0.0, None), (None, print)])
+def test_a_false_wait_or_a_signal_function_returns_the_job_as_dispatch_functions_does(
+        fake_picamera2: ModuleType, wait: Any, signal: Any) -> None:
+    cam = started(fake_picamera2)
+    job = cam.capture_request(wait=wait, signal_function=signal)
+    assert not isinstance(job, fake_picamera2.CompletedRequest)
+    job.future.result(timeout=1).release()
+    cam.close()
+
+
+def test_main_rows_are_padded_to_the_stride_and_mapped_without_it(fake_picamera2: ModuleType) -> None:
+    fake_picamera2.WORLD.producer = red
+    cam = started(fake_picamera2)  # 8 px × 3 bytes = 24: rows of 64 bytes
+    main = cam.camera_configuration()["main"]
+    assert main["stride"] == 64 and main["framesize"] == 64 * 6
+    request = cam.capture_request(wait=0.5)
+    with fake_picamera2.MappedArray(request, "main") as m:
+        assert m.array.shape == (6, 8, 3) and not m.array.flags.c_contiguous  # a view that skips the padding
+        assert (m.array == [0, 0, 200]).all()
+    copy = request.make_array("main")
+    assert copy.flags.c_contiguous and copy.shape == (6, 8, 3)
+    request.release()
+    cam.close()
+
+
+def test_what_libcamera_grants_instead_is_what_the_configuration_says(fake_picamera2: ModuleType) -> None:
+    import libcamera
+
+    fake_picamera2.WORLD.adjusted = {"main": {"format": "XBGR8888"}, "lores": {"format": "YVU420"},
+                                     "colour_space": libcamera.ColorSpace.Rec709()}
+    cam = fake_picamera2.Picamera2(0)
+    cam.configure(cam.create_video_configuration(main={"format": "RGB888", "size": (8, 6)}, lores={}))
+    granted = cam.camera_configuration()
+    assert granted["main"]["format"] == "XBGR8888" and granted["lores"]["format"] == "YVU420"
+    assert granted["colour_space"] == libcamera.ColorSpace.Rec709()
+    cam.close()

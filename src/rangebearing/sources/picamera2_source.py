@@ -4,7 +4,8 @@ Written against picamera2 (raspberrypi/picamera2: picamera2/picamera2.py,
 request.py, job.py) and the manual "The Picamera2 Library":
 
 * ``Picamera2(n)`` looks ``n`` up in ``global_camera_info()``, so a missing
-  camera raises IndexError; a camera held by another process fails in
+  camera raises IndexError (after opening a pipe it does not close: the camera
+  count is asked first); a camera held by another process fails in
   ``acquire()`` and surfaces as RuntimeError("Camera __init__ sequence did not
   complete.").
 * ``capture_request()`` without ``wait=`` blocks forever. With ``wait=t`` the
@@ -12,8 +13,18 @@ request.py, job.py) and the manual "The Picamera2 Library":
   TimeoutError only from Python 3.11) and the job stays queued: it would eat
   the next frame and leak its request, and ``stop()`` would queue behind it, so
   ``cancel_all_and_flush()`` must follow a timeout.
+  A false ``wait`` (``0``) would return the Job instead (``dispatch_functions``):
+  the config's ``timeout_s`` is always > 0.
 * ``"RGB888"`` pixels are stored [B, G, R] (request.py maps RGB888 to PIL mode
-  "BGR"), i.e. already OpenCV order: no channel swap here.
+  "BGR"), i.e. already OpenCV order: no channel swap here. ``configure()`` may
+  grant another format, size or colour space than asked (libcamera's
+  ``validate()``: "Adjusted"): the streams are read as ``camera_configuration()``
+  says (:func:`~.camera_buffers.granted`): BGR888/XBGR8888/XRGB8888 reordered,
+  YVU420 lores swapped back, the lores matrix from the granted colour space;
+  a main stream that is not RGB (a USB camera's YUYV, MJPEG) is a CameraError.
+* ``MappedArray`` gives the main stream as (H, W, C) with the rows' stride
+  padding sliced off (``_make_array_shared``), lores YUV420 as (H·3/2, stride)
+  with the padding left in: the planes are cut from it.
 * Every request must be released or the camera runs out of buffers.
 * ``lores`` (the manual's "lores" stream; YUV420 only on Pi 4 and earlier):
   requested at the main size, so its U and V planes are at half resolution,
@@ -42,7 +53,8 @@ from ..config import SourceConfig
 from ..core.yuv import Yuv420
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
-from .camera_buffers import Held, copied, lores_planes
+from .camera_buffers import Held, Layout, copied, granted
+from .camera_setup import camera_controls, camera_count, camera_count_text
 from .sensor_time import boot_offset_ns, frames_missed, sensor_to_monotonic_ns
 
 __all__ = ["Picamera2Source", "camera_controls", "frames_missed", "sensor_to_monotonic_ns"]
@@ -52,23 +64,6 @@ _log = logging.getLogger(__name__)
 
 INSTALL_HINT = "apt install python3-picamera2 and create the venv with --system-site-packages"
 _TIMEOUTS = (TimeoutError, concurrent.futures.TimeoutError)
-
-
-def camera_controls(cfg: SourceConfig) -> Dict[str, Any]:
-    """The libcamera controls for ``cfg``: a fixed frame rate, then ``cfg.controls`` on top.
-
-    ``FrameDurationLimits`` (µs, min and max) is what libcamera takes; newer
-    picamera2 also accepts ``FrameRate``, which it turns into the same thing.
-    """
-    controls: Dict[str, Any] = {}
-    if cfg.fps > 0:  # 0 (e.g. --fps 0): the camera's own default
-        frame_us = round(1e6 / cfg.fps)
-        controls["FrameDurationLimits"] = (frame_us, frame_us)
-    user = dict(cfg.controls)
-    if "FrameRate" in user:
-        controls.pop("FrameDurationLimits", None)
-    controls.update(user)
-    return controls
 
 
 def _import(name: str) -> Any:
@@ -112,8 +107,7 @@ class Picamera2Source:
         self._cam: Any = None
         self._mapped: Any = None  # picamera2.MappedArray, or None (very old picamera2: make_array copies)
         self._held: Optional[Held] = None  # the request of the frame last returned, with its mapped streams
-        self._width = cfg.width_px
-        self._lores_size: Optional[tuple] = None
+        self._layout: Optional[Layout] = None
         self._boot_offset_ns = 0
         self._prev_sensor_ns: Optional[int] = None
         self._next_index = 0
@@ -159,12 +153,13 @@ class Picamera2Source:
                 buffer_count=cfg.buffer_count,
             )
             cam.configure(config)
-            # picamera2 may round the sizes; rows are cropped to these widths.
-            active = cam.camera_configuration()
-            self._width = int(active["main"]["size"][0])
-            lores = active.get("lores")
-            self._lores_size = tuple(int(x) for x in lores["size"]) if lores else None
+            # what libcamera granted (validate() may adjust sizes, formats and the colour space)
+            self._layout = granted(cam.camera_configuration(), cfg.camera_num)
             cam.start()
+        except CameraError:
+            self._cam = cam
+            self.close()
+            raise
         except (RuntimeError, ValueError, KeyError, TypeError) as exc:
             self._cam = cam
             self.close()
@@ -183,9 +178,13 @@ class Picamera2Source:
         delay = self._backoff_s
         for attempt in range(1, attempts + 1):
             try:
+                # Picamera2(n) looks n up in global_camera_info() only after opening a pipe it never closes
+                # when n is not there: ask first (a camera that is plugged in later is found on a retry)
+                if n >= camera_count(picamera2_cls):
+                    raise IndexError(n)
                 return picamera2_cls(n)
             except IndexError:
-                error = CameraError(f"no camera {n} ({self._count_cameras(picamera2_cls)} found)")
+                error = CameraError(f"no camera {n} ({camera_count_text(picamera2_cls)} found)")
             except RuntimeError as exc:
                 error = CameraError(f"camera {n} busy or failing to open ({exc}); "
                                     "is another process using it?")
@@ -195,13 +194,6 @@ class Picamera2Source:
                     break
                 delay = min(delay * 2.0, self._max_backoff_s)
         raise error
-
-    @staticmethod
-    def _count_cameras(picamera2_cls: Any) -> str:
-        try:
-            return str(len(picamera2_cls.global_camera_info()))
-        except Exception:  # only for the message: never mask the real error
-            return "none"
 
     def read(self) -> Optional[Frame]:
         """The newest frame; FrameError on a timeout, CameraError on ``cfg.retries`` in a row.
@@ -220,19 +212,18 @@ class Picamera2Source:
             raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc}") from exc
         received_ns = self._clock()
         held = self._held = Held(request, self._mapped, self._cfg.camera_num)
+        layout = self._layout
         try:
             array = held.array("main")
-            lores = held.array("lores") if self._lores_size else None
+            lores = held.array("lores") if layout.lores_size else None  # type: ignore[union-attr]
             metadata = request.get_metadata()
         except (RuntimeError, ValueError) as exc:
             self._release_held()
             raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
         self._budget.frame_arrived()
         self._metadata = metadata
-        if isinstance(array, np.ndarray) and array.ndim == 3:
-            array = array[:, : self._width, :3]  # drop stride padding; RGB888 is already B,G,R
-        image = validate_frame(array)  # a view when the buffer is contiguous, else one copy
-        search = lores_planes(lores, self._lores_size, self._cfg.camera_num)
+        image = validate_frame(layout.bgr(array))  # type: ignore[union-attr]  # a view if contiguous, else a copy
+        search = layout.planes(lores)  # type: ignore[union-attr]
         if not self._in_place:  # the caller may keep the frame: copy it out, give the buffers back now
             image = image if image.flags.owndata else image.copy()
             search = copied(search)

@@ -9,7 +9,9 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
   frame. Without ``wait=`` it blocks forever; with ``wait=t`` it raises
   ``concurrent.futures.TimeoutError`` and the job STAYS queued, so it eats the
   next frame (and leaks its request) unless ``cancel_all_and_flush()`` is
-  called. ``stop()`` queues behind such a job and hangs.
+  called. ``stop()`` queues behind such a job and hangs. As
+  ``dispatch_functions`` does, a false ``wait`` (``False``, but also ``0``)
+  and ``wait=None`` with a ``signal_function`` return the Job, not a request.
 * ``"RGB888"`` arrays are [B, G, R] per pixel, ``"BGR888"`` [R, G, B],
   ``"XBGR8888"`` [R, G, B, 255], ``"XRGB8888"`` [B, G, R, 255].
 * Requests are reference counted and hold one of ``buffer_count`` buffers;
@@ -26,7 +28,15 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
   as SMPTE 170M (libcamera's default colour space for video below 1280×720):
   Y as OpenCV's ``COLOR_BGR2YUV_I420``, U and V from each 2×2 block's mean.
 * ``MappedArray(request, stream)`` maps the buffer in place (no copy, unlike
-  ``make_array``); mapping a released request fails.
+  ``make_array``); mapping a released request fails. The main stream's rows
+  are ``stride`` bytes, rounded up to 64 as the ISP does: ``MappedArray``
+  gives (H, W, C) with the padding sliced off (a view that is not
+  C-contiguous when rows are padded), as ``_make_array_shared`` does.
+* ``configure()`` fills each stream's ``stride`` and ``framesize``; where the
+  camera cannot give what was asked (libcamera's "Adjusted"), the test sets
+  ``WORLD.adjusted``, e.g. ``{"main": {"format": "XBGR8888"}, "colour_space":
+  libcamera.ColorSpace.Rec709()}``, and ``camera_configuration()`` says what
+  was granted, as picamera2 does after ``validate()``.
 
 * ``set_controls()`` takes effect ``WORLD.control_latency_frames`` frames
   later (libcamera applies controls a few frames on); ``ExposureTime`` or
@@ -95,6 +105,7 @@ class World:
         self.control_latency_frames = 2
         self.pixel_array = (3280, 2464)  # imx219
         self.set_controls_calls: List[Dict[str, Any]] = []
+        self.adjusted: Dict[str, Any] = {}  # what libcamera grants instead of what was asked (see configure)
 
     def set_stalled(self, stalled: bool) -> None:
         """Stall or resume the sensor; resuming completes jobs that are still queued."""
@@ -160,14 +171,19 @@ class CompletedRequest:
         if self._buffers is None:
             raise RuntimeError("failed to find buffer")  # released: the camera owns it again
         buf = self._buffers[name]
-        if name == "main":
-            return buf[:, : self.config["main"]["size"][0]]  # slices off stride padding, no copy
+        if name == "main":  # (H, stride) bytes: slice the padding off and shape the pixels, no copy
+            (w, h), fmt = self.config["main"]["size"], self.config["main"]["format"]
+            c = _BYTES_PER_PIXEL[fmt]
+            return buf[:, : w * c].reshape(h, w, c)
         return buf  # YUV420: (H·3/2, stride), padding left in, as picamera2 does
 
     def make_array(self, name: str) -> np.ndarray:
-        """A copy; main keeps ``WORLD.padded_width_px`` junk columns, as old picamera2 did."""
-        self._shared(name)  # the same checks
-        return self._buffers[name].copy()
+        """A contiguous copy; main gets ``WORLD.padded_width_px`` junk columns, as old picamera2 did."""
+        array = np.ascontiguousarray(self._shared(name)).copy()
+        if name == "main" and WORLD.padded_width_px:
+            pad = np.full((array.shape[0], WORLD.padded_width_px, array.shape[2]), 77, dtype=np.uint8)
+            array = np.concatenate([array, pad], axis=1)
+        return array
 
     def get_metadata(self) -> Dict[str, Any]:
         return dict(self._metadata)
@@ -272,7 +288,10 @@ class Picamera2:
         if self.started:
             raise RuntimeError("Camera must be stopped before configuring")
         config = dict(camera_config)
-        main = dict(config["main"])
+        adjusted = dict(WORLD.adjusted)  # libcamera's validate(): what the camera can give instead
+        if "colour_space" in adjusted:
+            config["colour_space"] = adjusted.pop("colour_space")
+        main = {**config["main"], **adjusted.get("main", {})}
         if main["format"] not in _BYTES_PER_PIXEL:
             raise RuntimeError(f"Bad format {main['format']} in stream main")
         if not isinstance(config["transform"], libcamera.Transform):
@@ -285,15 +304,17 @@ class Picamera2:
             if name not in _KNOWN_CONTROLS:
                 raise RuntimeError(f"Control {name} is not advertised by libcamera")
         config["controls"] = controls
-        main["stride"] = main["size"][0] * _BYTES_PER_PIXEL[main["format"]]
+        main["stride"] = -(-main["size"][0] * _BYTES_PER_PIXEL[main["format"]] // 64) * 64  # the ISP's alignment
+        main["framesize"] = main["stride"] * main["size"][1]
         config["main"] = main
         if config.get("lores") is not None:
-            lores = dict(config["lores"])
+            lores = {**config["lores"], **adjusted.get("lores", {})}
             if lores["format"] not in ("YUV420", "YVU420"):
                 raise RuntimeError("lores stream must be YUV")
             if lores["size"][0] > main["size"][0] or lores["size"][1] > main["size"][1]:
                 raise RuntimeError("lores stream dimensions may not exceed main stream")
             lores["stride"] = -(-lores["size"][0] // 64) * 64  # the ISP's row alignment
+            lores["framesize"] = lores["stride"] * lores["size"][1] * 3 // 2
             config["lores"] = lores
         self.camera_config = config
         self._applied = dict(controls)
@@ -328,9 +349,11 @@ class Picamera2:
             WORLD.capture_waits.append(wait)
             self._jobs.append(job)
             self._pump()
-        if wait is False:
+        if wait is None:  # dispatch_functions: wait unless a signal function was given
+            wait = signal_function is None
+        if not wait:  # False, or 0: the job itself
             return job
-        timeout = None if wait is None or wait is True else float(wait)
+        timeout = None if wait is True else float(wait)
         return job.future.result(timeout=timeout)  # None: blocks until a frame or a cancel
 
     def cancel_all_and_flush(self) -> None:
@@ -411,10 +434,9 @@ class Picamera2:
             rgb = rgb[:, ::-1]
         if transform.vflip:
             rgb = rgb[::-1]
-        image = _to_format(rgb, main["format"])
-        if WORLD.padded_width_px:
-            pad = np.full((h, WORLD.padded_width_px, image.shape[2]), 77, dtype=np.uint8)
-            image = np.concatenate([image, pad], axis=1)
+        pixels = _to_format(rgb, main["format"])
+        image = np.full((h, main["stride"]), 77, np.uint8)  # rows of stride bytes; the padding is junk
+        image[:, : pixels.shape[1] * pixels.shape[2]] = pixels.reshape(h, -1)
         duration_us = int(self.camera_config["controls"]["FrameDurationLimits"][0])
         period_ns = WORLD.frame_period_ns or duration_us * 1000
         metadata = {
@@ -422,7 +444,7 @@ class Picamera2:
             "FrameDuration": period_ns // 1000,
             **exposure,
         }
-        return CompletedRequest(self, np.ascontiguousarray(image), metadata, self._lores(rgb))
+        return CompletedRequest(self, image, metadata, self._lores(rgb))
 
     def _lores(self, rgb: np.ndarray) -> Optional[np.ndarray]:
         """The lores stream's I420 buffer for this frame's RGB content (None without a lores stream)."""
@@ -441,8 +463,8 @@ class Picamera2:
         buf = np.full((h * 3 // 2, stride), 77, np.uint8)
         buf[:h, :w] = flat[: w * h].reshape(h, w)
         chroma = buf[h:].reshape(2, h // 2, stride // 2)
-        chroma[0, :, : w // 2] = flat[w * h: w * h + n].reshape(h // 2, w // 2)
-        chroma[1, :, : w // 2] = flat[w * h + n:].reshape(h // 2, w // 2)
+        u, v = flat[w * h: w * h + n].reshape(h // 2, w // 2), flat[w * h + n:].reshape(h // 2, w // 2)
+        chroma[0, :, : w // 2], chroma[1, :, : w // 2] = (u, v) if lores["format"] == "YUV420" else (v, u)
         return buf
 
 
