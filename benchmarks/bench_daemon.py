@@ -260,6 +260,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=None, help="window per run (default 10 s at 30 fps, 5 s else)")
     p.add_argument("--runs", type=int, default=1, help="runs per frame rate")
     p.add_argument("--frames", type=int, default=60)
+    p.add_argument("--scan-after-send", choices=("off", "on", "both"), default="off",
+                   help="daemon.scan_after_send; both: alternate the two in each run (default off)")
     p.add_argument("--no-bytecode", action="store_true",
                    help="do not compile the package's modules beforehand (whatever __pycache__ holds is used)")
     args = p.parse_args(argv)
@@ -267,17 +269,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {max(os.sched_getaffinity(0))})
     cfg, frames = bench_clip(args.frames)
-    print("| fps | bytecode | start-up s (CPU s) | datagrams / due | dropped | gaps | CPU % | CPU ms/frame "
-          "| pipeline ms/frame (tracked) | rest ms/frame | p50 / p99 / max ms | RSS / peak MiB | load |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    modes = {"off": (False,), "on": (True,), "both": (False, True)}[args.scan_after_send]
+    print("| fps | scan after send | bytecode | start-up s (CPU s) | datagrams / due | dropped | gaps | CPU % "
+          "| CPU ms/frame | pipeline ms/frame (tracked) | rest ms/frame | p50 / p99 / max ms | RSS / peak MiB | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for fps in args.fps:
-        for _ in range(args.runs):
+        for _, later in ((run, later) for run in range(args.runs) for later in modes):
             seconds = args.seconds or (10.0 if fps <= 30 else 5.0)
-            d = daemon_run(cfg, frames, fps, seconds, bytecode=not args.no_bytecode)
+            run_cfg = dataclasses.replace(cfg, daemon=dataclasses.replace(cfg.daemon, scan_after_send=later))
+            d = daemon_run(run_cfg, frames, fps, seconds, bytecode=not args.no_bytecode)
             if d.error:
-                print(f"| {fps:g} | failed: {d.error[:300]} |")
+                print(f"| {fps:g} | {'on' if later else 'off'} | failed: {d.error[:300]} |")
                 continue
-            print(f"| {fps:g} | {'yes' if d.bytecode else 'no'} | {d.startup_s:.3f} ({d.startup_cpu_s:.3f}) "
+            print(f"| {fps:g} | {'on' if later else 'off'} | {'yes' if d.bytecode else 'no'} "
+                  f"| {d.startup_s:.3f} ({d.startup_cpu_s:.3f}) "
                   f"| {d.received} / {d.frames_expected} | {d.dropped} | {d.seq_gaps} | {d.cpu_pct:.2f} "
                   f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "
                   f"| {d.cpu_ms_per_frame - d.pipeline_cpu_ms:.3f} "

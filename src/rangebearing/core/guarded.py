@@ -13,7 +13,7 @@ keep counting, so none is reused).
 from __future__ import annotations
 
 import traceback
-from typing import Optional
+from typing import Callable, Optional, Tuple, TypeVar
 
 import numpy as np
 
@@ -22,7 +22,9 @@ from .pipeline import Pipeline
 from .types import FrameResult
 from .yuv import Yuv420
 
-__all__ = ["DetectorFault", "process_or_skip", "where"]
+__all__ = ["DetectorFault", "process_or_skip", "scan_later_or_skip", "where"]
+
+T = TypeVar("T")
 
 
 def where(exc: BaseException) -> str:
@@ -44,8 +46,22 @@ def process_or_skip(pipe: Pipeline, image: np.ndarray, t_s: Optional[float] = No
         The frame is unusable (as from :meth:`Pipeline.process`), or the detector
         failed on it (:class:`DetectorFault`, its cause chained).
     """
+    return _guarded(pipe, lambda: pipe.process(image, t_s=t_s, search=search))
+
+
+def scan_later_or_skip(pipe: Pipeline, image: np.ndarray, t_s: Optional[float] = None,
+                       search: Optional[Yuv420] = None
+                       ) -> Tuple[FrameResult, Optional[Callable[[], FrameResult]]]:
+    """:meth:`Pipeline.process_scan_later` guarded as :func:`process_or_skip`, and so is the scan it leaves."""
+    result, finish = _guarded(pipe, lambda: pipe.process_scan_later(image, t_s, search))
+    if finish is None:
+        return result, None
+    return result, lambda: _guarded(pipe, finish)
+
+
+def _guarded(pipe: Pipeline, run: Callable[[], T]) -> T:
     try:
-        return pipe.process(image, t_s=t_s, search=search)
+        return run()
     except RangeBearingError:
         raise
     except Exception as exc:  # deliberately broad: a defect on one frame must not end the run

@@ -15,7 +15,7 @@ a full scan or in tracking windows).
 from __future__ import annotations
 
 import dataclasses
-from typing import Dict, List, Optional, Tuple
+from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -203,6 +203,45 @@ class Pipeline:
                                       out.bearing_rate_radps.tolist())
         )
         return FrameResult(landmarks=landmarks, tracked=tracked)
+
+    def process_scan_later(
+        self, frame: np.ndarray, t_s: Optional[float] = None, search: Optional[Yuv420] = None
+    ) -> Tuple[FrameResult, Optional[Callable[[], FrameResult]]]:
+        """:meth:`process`, with a periodic full scan left for after this frame's readings are out.
+
+        When the frame's full scan is only the periodic one (tracks followed,
+        none lost, none crossing, nothing coming in), the frame is tracked
+        like the ones before it, and the returned ``finish`` runs the full
+        scan on the same frame from the state before it: after ``finish()``
+        the pipeline is exactly as :meth:`process` would have left it, so every
+        later frame reads the same. Only this frame's readings differ (they are
+        the tracked ones; a newcomer shows one frame later). ``finish`` is None
+        when nothing was left over; call it before the next frame (it reads
+        ``frame`` and ``search`` again) or never (the next frame is then the
+        full scan).
+        """
+        det = self.params.detection
+        due = (self.track and bool(self._tracks) and det.method != "paper" and det.full_scan_every > 1
+               and self._since_scan == det.full_scan_every - 1)
+        if not due:
+            return self.process(frame, t_s, search), None
+        before = dict(self.__dict__)  # the state is rebound, never changed in place: a shallow copy keeps it
+        self._since_scan -= 1
+        result = self.process(frame, t_s, search)
+        if not result.tracked:  # a full scan was needed anyway (crossing, a newcomer): done already
+            return result, None
+        self._since_scan = det.full_scan_every  # left unfinished, the scan is the next frame's (never deferred)
+        after = dict(self.__dict__)
+
+        def finish() -> FrameResult:
+            self.__dict__.update(before)
+            try:
+                return self.process(frame, t_s, search)
+            except BaseException:
+                self.__dict__.update(after)  # as if the scan had never been started
+                raise
+
+        return result, finish
 
     def _reading(self, c: BandCentroids, cam: CameraIntrinsics, bgr: np.ndarray) -> tuple:
         """A :class:`Landmark`'s fields up to ``visible``, in its order (the ids come after)."""

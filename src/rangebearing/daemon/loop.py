@@ -20,19 +20,21 @@ import logging
 import signal
 import threading
 import time
-from typing import TYPE_CHECKING, Callable, Optional
+from typing import TYPE_CHECKING, Callable, Optional, Tuple
 
 from .. import _signals
 from ..config import Config
-from ..core.guarded import DetectorFault, process_or_skip
+from ..core.guarded import DetectorFault, process_or_skip, scan_later_or_skip
 from ..core.pipeline import Pipeline
-from ..errors import ConfigError, FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
+from ..core.types import FrameResult
+from ..errors import FrameError, FrameShapeError, ProtocolError, RangeBearingError, SourceError
 from ..net.fit import encode_fitting
 from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource, kept
 from .capture import CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
 from .recorder import NoRecorder, Recorder
+from .reload import Reloading
 from .stats import LoopStats, Summary
 
 if TYPE_CHECKING:
@@ -46,7 +48,7 @@ Reload = Callable[[], Config]
 Echo = Callable[[bytes], None]
 
 
-class Daemon:
+class Daemon(Reloading):
     """Run the capture loop until the source ends, a stop is requested, or the source fails.
 
     Parameters
@@ -72,11 +74,8 @@ class Daemon:
     recorder : Recorder, optional
         Given every frame with the reading sent for it (``run --record``); closed when the loop ends.
     freeze_gc : bool
-        After the first frame, move every object alive (modules, config, the
-        pipeline's tables) out of the cyclic garbage collector's reach
-        (``gc.freeze``): they are never garbage, and a collection that rescans
-        them is a pause in the frame it lands on. For the daemon's own process
-        (``rangebearing run``), not for a library caller's.
+        After the first frame, ``gc.freeze`` every object alive (modules, config, tables: never garbage, and
+        a collection that rescans them is a pause in its frame). For ``rangebearing run``'s own process.
     """
 
     def __init__(
@@ -181,7 +180,7 @@ class Daemon:
                         log.info("end of stream")
                     return 0
                 t0, c0 = clock(), thread_cpu()
-                result = process_or_skip(self._pipe, frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420)
+                result, scan = self._process(frame)
                 t1, c1 = clock(), thread_cpu()
                 pub = self.cfg.publish
                 t_unix = _unix_time(frame, t1)
@@ -195,6 +194,10 @@ class Daemon:
             self._publisher.send(payload)  # type: ignore[union-attr]
             t2, seq = clock(), seq + 1
             stages = {"wait": t0 - t_read, "process": t1 - t0, "send": t2 - t1}
+            if scan is not None:  # this frame's full scan, now that its readings are out (counted as its pipeline's)
+                c_scan = _scanned(scan)
+                c1 += thread_cpu() - c_scan
+                stages["scan"] = clock() - t2
             self.stats.frame_done(t2, t2 - frame.t_mono_ns, len(result.landmarks), stages, c1 - c0, result.tracked)
             self._echo(payload)
             if self._recording:
@@ -208,6 +211,12 @@ class Daemon:
                 status = dataclasses.asdict(self.summary())
                 self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, status)
         return 0
+
+    def _process(self, frame: Frame) -> Tuple[FrameResult, Optional[Callable[[], FrameResult]]]:
+        """The frame's readings, and its periodic full scan if ``daemon.scan_after_send`` leaves it for later."""
+        if self.cfg.daemon.scan_after_send:  # a detector defect is this frame's (or its scan's): core/guarded
+            return scan_later_or_skip(self._pipe, frame.image, frame.t_mono_ns / 1e9, frame.lores_yuv420)
+        return process_or_skip(self._pipe, frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420), None
 
     def _view_thresholds(self) -> None:
         """Detect with the thresholds a browser set, from this frame on (a new pipeline: tracks restart)."""
@@ -243,55 +252,21 @@ class Daemon:
             bug = exc.__cause__ if isinstance(exc, DetectorFault) else None  # a defect's traceback goes to the journal
             log.warning("%s (%d so far): %s", what, n, exc, exc_info=bug)
 
-    def _do_reload(self) -> None:
-        """Swap in the reloaded config; keep everything as it was if the new one is bad.
 
-        Nothing a config file holds may end a running daemon: beyond ConfigError, any
-        failure of the reload itself is logged and the running config kept.
-        """
-        try:
-            self._reload_once()
-        except SourceError:
-            raise  # the old camera could not be reopened either: the camera policy decides
-        except Exception as exc:  # deliberately broad: a reload must never end the daemon
-            log.error("reload failed, keeping the running config: %s: %s", type(exc).__name__, str(exc)[:300])
+def _scanned(scan: Callable[[], FrameResult]) -> int:
+    """Run a full scan left over from the frame just sent; the thread CPU clock before it (ns).
 
-    def _reload_once(self) -> None:
-        self._reload.clear()
-        self.house.reloading()
-        try:
-            if self._reload_config is None:
-                log.warning("SIGHUP ignored: no --config file to reload")
-                return
-            try:
-                new = self._reload_config()
-                new_pub = self._open_publisher(new)
-            except ConfigError as exc:
-                log.error("reload rejected, keeping the running config: %s", exc)
-                return
-            if new.source != self.cfg.source and not self._swap_source(new):
-                new_pub.close()
-                return
-            self._publisher.close()  # type: ignore[union-attr]
-            if new.pipeline != self.cfg.pipeline:
-                self._pipe = Pipeline(new.pipeline, first_track_id=self._pipe.next_track_id)  # ids never reused
-            if new.daemon.view_port != self.cfg.daemon.view_port or new.daemon.view_host != self.cfg.daemon.view_host:
-                log.warning("daemon.view_port / view_host changes take effect at the next start")
-            self._publisher, self.cfg = new_pub, new
-            src = new.source
-            self.guard.timeout_s, self.guard.budget_s = src.timeout_s, src.timeout_s * src.retries
-            if self.view is not None:
-                from ..view.thresholds import Thresholds  # with the view page only
-                self.view.reset_thresholds(Thresholds.of(new.detection))
-            log.info("config reloaded")
-        finally:
-            self.house.reloaded()
-
-    def _swap_source(self, new: Config) -> bool:
-        """Open the new config's source in place of the running one (:meth:`CaptureGuard.swap`)."""
-        old = self.cfg
-        return self.guard.swap(lambda sleep: self._open_source(new, sleep), new.source.timeout_s * 2,
-                               lambda sleep: self._open_source(old, sleep), old.source.open_timeout_s)
+    A frame that cannot be scanned was read already: the pipeline stays as its tracked step left it.
+    """
+    c0 = time.thread_time_ns()
+    try:
+        scan()
+    except FrameShapeError:
+        raise
+    except FrameError as exc:  # a DetectorFault restarted the tracks
+        log.warning("full scan after the send failed: %s", exc,
+                    exc_info=exc.__cause__ if isinstance(exc, DetectorFault) else None)
+    return c0
 
 
 def _unix_time(frame: Frame, now_mono_ns: int) -> float:
