@@ -64,6 +64,7 @@ class DaemonFigures:
     pipeline_cpu_ms: float = float("nan")  # the daemon's own figure: the pipeline's CPU per frame (its final log line)
     tracked_pct: float = float("nan")  # frames the pipeline tracked rather than scanned whole
     bytecode: bool = True  # the package's modules were compiled beforehand, as an installed package's are
+    restart: bool = True  # a start after a first one with the same config (the package's cache filled)
     clip_mib: float = float("nan")  # the recorded clip decoded (frames and their YUV420): in the page cache, not RSS
 
 
@@ -155,11 +156,14 @@ _SUMMARY = re.compile(r"stopped: .*pipeline CPU ([0-9.]+) ms/frame \(([0-9.]+) %
 
 
 def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s: float,
-               bytecode: bool = True) -> DaemonFigures:
+               bytecode: bool = True, restart: bool = True) -> DaemonFigures:
     """Run ``rangebearing run`` on ``frames`` (PNG, looped) paced at ``fps``; measure it from outside.
 
     ``bytecode``: compile the package's modules beforehand (as installed); False leaves
     them as they are (an editable checkout under PYTHONDONTWRITEBYTECODE compiles them at each start).
+    ``restart``: the start of a robot's daemon after its first, with the same config (a reboot, a
+    systemd restart): ``run --check`` on the config beforehand fills the package's cache (the parsed
+    config, the dataclass methods' code) as that first start did; False turns the cache off.
     """
     with tempfile.TemporaryDirectory(prefix="rb-bench-") as tmp:
         clip = Path(tmp) / "clip"
@@ -179,6 +183,11 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         env.pop("NOTIFY_SOCKET", None)
         if bytecode:
             _compile_package()
+        if restart:
+            subprocess.run([*_command(), "run", "--check", "--config", str(conf)], env=env, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        else:
+            env["RANGEBEARING_CACHE"] = "off"
         t0 = time.perf_counter()
         proc = subprocess.Popen([*_command(), "run", "--config", str(conf)], stdout=log, stderr=log, env=env)
         error, code = "", -1
@@ -208,7 +217,7 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
             log.close()
         if error:
             return DaemonFigures(fps, duration_s, float("nan"), 0, 0, 0, 0, *([float("nan")] * 8), code,
-                                 f"{error}; log: {tail}", bytecode=bytecode)
+                                 f"{error}; log: {tail}", bytecode=bytecode, restart=restart)
     summary = _SUMMARY.search(tail)
     window = listener.got[n0:n1]
     lat = np.array([(arr - msg["t"]) * 1e3 for arr, _, msg in window]) if window else np.array([np.nan])
@@ -236,6 +245,7 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         pipeline_cpu_ms=float(summary.group(1)) if summary else float("nan"),
         tracked_pct=float(summary.group(2)) if summary else float("nan"),
         bytecode=bytecode,
+        restart=restart,
         clip_mib=sum(f.nbytes for f in frames) * (1.5 if run_cfg.source.lores else 1.0) / 2**20,
     )
 
@@ -262,6 +272,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--frames", type=int, default=60)
     p.add_argument("--scan-after-send", choices=("off", "on", "both"), default="off",
                    help="daemon.scan_after_send; both: alternate the two in each run (default off)")
+    p.add_argument("--first-start", action="store_true",
+                   help="the package's cache off (parsed config, dataclass methods): a robot's very first start")
     p.add_argument("--no-bytecode", action="store_true",
                    help="do not compile the package's modules beforehand (whatever __pycache__ holds is used)")
     args = p.parse_args(argv)
@@ -277,11 +289,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         for _, later in ((run, later) for run in range(args.runs) for later in modes):
             seconds = args.seconds or (10.0 if fps <= 30 else 5.0)
             run_cfg = dataclasses.replace(cfg, daemon=dataclasses.replace(cfg.daemon, scan_after_send=later))
-            d = daemon_run(run_cfg, frames, fps, seconds, bytecode=not args.no_bytecode)
+            d = daemon_run(run_cfg, frames, fps, seconds, bytecode=not args.no_bytecode, restart=not args.first_start)
             if d.error:
                 print(f"| {fps:g} | {'on' if later else 'off'} | failed: {d.error[:300]} |")
                 continue
-            print(f"| {fps:g} | {'on' if later else 'off'} | {'yes' if d.bytecode else 'no'} "
+            print(f"| {fps:g} | {'on' if later else 'off'} | {'yes' if d.bytecode else 'no'}"
+                  f"{'' if d.restart else ', first start'} "
                   f"| {d.startup_s:.3f} ({d.startup_cpu_s:.3f}) "
                   f"| {d.received} / {d.frames_expected} | {d.dropped} | {d.seq_gaps} | {d.cpu_pct:.2f} "
                   f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "

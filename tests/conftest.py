@@ -2,11 +2,21 @@
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
+import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 from types import ModuleType
 from typing import Iterator, List
+
+# The package's caches (parsed configs, dataclass methods: rangebearing._compat.cache_dir) go to a temp dir of
+# this run, never the user's ~/.cache; set before rangebearing is imported. Subprocesses inherit it.
+if "RANGEBEARING_CACHE" not in os.environ:
+    os.environ["RANGEBEARING_CACHE"] = tempfile.mkdtemp(prefix="rb-test-cache-")
+    atexit.register(shutil.rmtree, os.environ["RANGEBEARING_CACHE"], True)
 
 import cv2
 import numpy as np

@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import shutil
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
@@ -71,6 +70,8 @@ def write_atomic(path: Union[str, Path], text: str) -> Optional[Path]:
     backup = None
     if out.exists():
         backup = out.with_name(out.name + ".bak")
+        import shutil  # not on `run`'s start-up path (it brings bz2 and lzma)
+
         try:
             shutil.copy2(out, backup)
         except OSError as exc:

@@ -41,9 +41,35 @@ EXIT_CONFIG = 2  # a bad config or command line, as argparse does
 EXIT_INTERRUPTED = 130
 
 
+class _Formatter(argparse.HelpFormatter):
+    """argparse's help layout, its width found as ``shutil`` does, without importing it (with bz2, lzma: ~3 ms).
+
+    argparse builds a formatter at every ``add_argument``, so the default one
+    imports ``shutil`` in every start of every command.
+    """
+
+    def __init__(self, prog: str, indent_increment: int = 2, max_help_position: int = 24,
+                 width: Optional[int] = None) -> None:
+        super().__init__(prog, indent_increment, max_help_position, _columns() - 2 if width is None else width)
+
+
+def _columns() -> int:
+    """``shutil.get_terminal_size().columns``: ``$COLUMNS``, else stdout's terminal, else 80."""
+    try:
+        columns = int(os.environ.get("COLUMNS", "0"))
+    except ValueError:
+        columns = 0
+    if columns <= 0:
+        try:
+            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns  # type: ignore[union-attr]
+        except (AttributeError, ValueError, OSError):
+            columns = 0
+    return columns if columns > 0 else 80
+
+
 def common_options() -> argparse.ArgumentParser:
     """Options accepted both before and after the command name (``rangebearing -v run`` = ``run -v``)."""
-    p = argparse.ArgumentParser(add_help=False)
+    p = argparse.ArgumentParser(add_help=False, formatter_class=_Formatter)
     p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="log debug messages")
     p.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help="show the traceback of an error"
@@ -69,6 +95,7 @@ def build_parser(argv: Optional[List[str]] = None) -> argparse.ArgumentParser:
         description="Range and bearing to red/blue cylinder landmarks, from a camera or recorded frames.",
         epilog="Run 'rangebearing COMMAND --help' for each command's options.",
         parents=[common],
+        formatter_class=_Formatter,
     )
     parser.add_argument("--version", action="version", version=f"rangebearing {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -79,7 +106,7 @@ def build_parser(argv: Optional[List[str]] = None) -> argparse.ArgumentParser:
             module = importlib.import_module(f".{name}_cmd", __package__)
             module.register(_WithCommon(sub, common))
         else:  # listed in --help, not imported
-            sub.add_parser(name, help=help_text, add_help=False)
+            sub.add_parser(name, help=help_text, add_help=False, formatter_class=_Formatter)
     return parser
 
 
@@ -91,6 +118,7 @@ class _WithCommon:
 
     def add_parser(self, name: str, **kwargs: object) -> argparse.ArgumentParser:
         parents = [*kwargs.pop("parents", []), self._common]  # type: ignore[misc]
+        kwargs.setdefault("formatter_class", _Formatter)
         return self._sub.add_parser(name, parents=parents, **kwargs)  # type: ignore[arg-type]
 
 

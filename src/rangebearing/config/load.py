@@ -13,13 +13,11 @@ import dataclasses
 from pathlib import Path
 from typing import Any, Callable, Dict, Mapping, Optional, Tuple, Union
 
-import yaml
-
 from ..errors import ConfigError
 from . import checks as ck
 from .camera_model import PRESET_KEYS, split_camera
+from .parsed_cache import parsed
 from .schema import MAX_CAPTURE_BUDGET_S, SCHEMA, Config
-from .yaml_safe import load_yaml
 
 
 def config_from_mapping(data: Any, source: str = "<config>", base: Optional[Config] = None) -> Config:
@@ -161,7 +159,7 @@ def load_config(path: Union[str, Path, None] = None) -> Config:
         return Config()
     source = ck.show(str(path), 200)[1:-1]
     try:
-        cfg = config_from_mapping(load_yaml(path), source)
+        cfg = config_from_mapping(parsed(path, _load_yaml), source)
         if cfg.source.path and not Path(cfg.source.path).is_absolute():  # relative to the file, not the cwd
             resolved = str((Path(path).parent / cfg.source.path).resolve())
             cfg = dataclasses.replace(cfg, source=dataclasses.replace(cfg.source, path=resolved))
@@ -174,6 +172,12 @@ def load_config(path: Union[str, Path, None] = None) -> Config:
         raise ConfigError([f"cannot use this file: {type(exc).__name__}: {ck.show(str(exc), 200)[1:-1]}"],
                           source) from None
     return cfg
+
+
+def _load_yaml(path: Union[str, Path]) -> Any:
+    from .yaml_safe import load_yaml  # PyYAML: only when the file was not parsed before (.parsed_cache)
+
+    return load_yaml(path)
 
 
 def config_to_mapping(cfg: Config) -> Dict[str, Any]:
@@ -201,4 +205,6 @@ def config_to_mapping(cfg: Config) -> Dict[str, Any]:
 
 def dump_config(cfg: Config) -> str:
     """The config as YAML text that :func:`load_config` accepts unchanged."""
+    import yaml
+
     return yaml.safe_dump(config_to_mapping(cfg), sort_keys=False, default_flow_style=None)
