@@ -106,7 +106,8 @@ def test_quick_run_daemon_subprocess_published_paced_frames(quick_run):
     assert [r["fps asked"] for r in rows] == ["30", "90"]
     for row in rows:
         sent, due = (int(x) for x in row["datagrams / frames due"].split("/"))
-        assert due == int(row["fps asked"]) and 0.8 * due <= sent <= due + 2  # 1 s window
+        # a 1 s window, as long as the harness's sleep really took (under load it overshoots by tens of ms)
+        assert abs(due - int(row["fps asked"])) <= max(2, 0.1 * due) and 0.8 * due <= sent <= due + 2
         assert 0.0 < float(row["start-up s (to 1st datagram)"]) < 30.0
         assert 0.0 < float(row["CPU % of a core"]) < 100.0
         rss, peak = (float(x) for x in row["RSS / peak MiB"].split("/"))
