@@ -54,3 +54,25 @@ def test_a_newcomer_is_sent_one_frame_after_the_scan_that_found_it():
         if first_later is None and len(got.landmarks) == 3:
             first_later = i
     assert first_now is not None and first_later == first_now + 1
+
+
+def test_a_defect_in_the_scan_left_for_later_is_that_frame_s_and_restarts_the_tracks(monkeypatch):
+    import pytest
+
+    from rangebearing.core import pipeline as pipeline_module
+    from rangebearing.core.guarded import DetectorFault, scan_later_or_skip
+
+    _, pipe = _pipes()
+    frames = list(moving_sequence(5))
+    for i, img in enumerate(frames[:4]):
+        assert scan_later_or_skip(pipe, img, i / 30)[1] is None
+    result, scan = scan_later_or_skip(pipe, frames[4], 4 / 30)
+    assert scan is not None and len(result.landmarks) == 2
+
+    def broken(*args, **kwargs):
+        raise IndexError("a defect")
+
+    monkeypatch.setattr(pipeline_module, "refine", broken)  # only the full scan refines
+    with pytest.raises(DetectorFault, match="IndexError"):
+        scan()
+    assert pipe._tracks == [] and pipe.next_track_id == 2  # tracks restarted, ids keep counting
