@@ -115,6 +115,11 @@ if [ -e "$CONFIG" ]; then
 else
     run install -m 0644 "$SRC_DIR/config/rangebearing.yaml" "$CONFIG"
 fi
+# The daemon may write nowhere; its start-up reads what this check leaves here (the parsed config, the
+# dataclasses' compiled methods: docs/daemon-cost.md). Edited the config later? Run this line again.
+run install -d -m 0755 "$PREFIX/cache"
+run env RANGEBEARING_CACHE="$PREFIX/cache" "$VENV/bin/rangebearing" run --check --config "$CONFIG" \
+    || say "warning: $CONFIG does not pass 'rangebearing run --check' (see above); the daemon will say so too"
 
 say "6/7 unit $UNIT_DIR/$UNIT"
 run install -m 0644 "$SRC_DIR/systemd/$UNIT" "$UNIT_DIR/$UNIT"

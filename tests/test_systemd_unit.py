@@ -282,6 +282,19 @@ def test_install_dry_run_prints_steps_and_executes_nothing(
     assert not log.exists(), f"dry run executed: {log.read_text()}"
 
 
+@pytest.mark.parametrize("shell", SHELLS)
+def test_the_daemon_reads_the_start_up_cache_the_install_fills(shell: str, stub_path: Stub, unit: Unit) -> None:
+    env, _ = stub_path
+    assert "RANGEBEARING_CACHE=/opt/rangebearing/cache" in values(unit, "Service", "Environment")
+    proc = subprocess.run([shell, str(INSTALL), "--dry-run"], capture_output=True, text=True, env=env,
+                          timeout=30, check=False)
+    assert proc.returncode == 0, proc.stderr
+    warm = ("env RANGEBEARING_CACHE=/opt/rangebearing/cache /opt/rangebearing/venv/bin/rangebearing run --check "
+            "--config /etc/rangebearing/config.yaml")
+    assert warm in proc.stdout
+    assert proc.stdout.index("pip install") < proc.stdout.index(warm) < proc.stdout.index("systemctl restart")
+
+
 @pytest.mark.skipif(sys.platform != "linux", reason="the install script targets Linux")
 @pytest.mark.parametrize("edited", [True, False])
 def test_install_never_overwrites_an_existing_config(
