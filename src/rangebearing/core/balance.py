@@ -86,14 +86,8 @@ def merge_candidates(first: Sequence[Candidate], more: Sequence[Candidate], max_
     return out
 
 
-def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
-    """Median (B, G, R) of a candidate's white body, or ``None`` when too little of it is usable.
-
-    The inner half of its columns (limbs are shaded and mixed with the
-    background) and the middle two thirds of the rows between the bands; clipped
-    pixels (a channel ≥ 250: the ratio is lost) and dark ones (max < 20) are
-    left out. The median ignores a flag or mast in front of part of the body.
-    """
+def _body_sample(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
+    """The pixels :func:`white_body_colour` samples of a candidate's white body (a strided view), or ``None``."""
     rx, ry, rw, rh = c.red_bbox_px
     top, bottom = ry + rh, c.blue_bbox_px[1]
     h, w = bottom - top, rw
@@ -105,13 +99,44 @@ def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
     if y1 <= y0 or x1 <= x0:
         return None
     sy, sx = max(1, (y1 - y0) // SAMPLES), max(1, (x1 - x0) // SAMPLES)
-    sub = bgr[y0:y1:sy, x0:x1:sx]
+    return bgr[y0:y1:sy, x0:x1:sx]
+
+
+def white_body_colour(bgr: np.ndarray, c: Candidate) -> Optional[np.ndarray]:
+    """Median (B, G, R) of a candidate's white body, or ``None`` when too little of it is usable.
+
+    The inner half of its columns (limbs are shaded and mixed with the
+    background) and the middle two thirds of the rows between the bands; clipped
+    pixels (a channel ≥ 250: the ratio is lost) and dark ones (max < 20) are
+    left out. The median ignores a flag or mast in front of part of the body.
+    """
+    return _body_colours(bgr, [c])[0]
+
+
+def _body_colours(bgr: np.ndarray, cands: Sequence[Candidate]) -> List[Optional[np.ndarray]]:
+    """:func:`white_body_colour` of every candidate, the usable pixels of all picked in one go."""
+    samples = [_body_sample(bgr, c) for c in cands]
+    live = [s.reshape(-1, 3) for s in samples if s is not None]
+    if not live:
+        return [None] * len(samples)
+    px = live[0] if len(live) == 1 else np.concatenate(live)
     # the channels' maximum pairwise: numpy's reduction over a length-3 axis is ~10x slower
-    top_ch = np.maximum(np.maximum(sub[..., 0], sub[..., 1]), sub[..., 2])
-    px = np.compress(((top_ch >= DARK) & (top_ch < CLIPPED)).ravel(), sub.reshape(-1, 3), axis=0)  # = sub[mask]
-    if len(px) < MIN_WHITE_PX:
-        return None
-    return median_rows(px)
+    top_ch = np.maximum(np.maximum(px[:, 0], px[:, 1]), px[:, 2])
+    usable = (top_ch >= DARK) & (top_ch < CLIPPED)
+    ends = np.cumsum([len(s) for s in live])
+    kept = np.cumsum(usable)[ends - 1].tolist()  # usable pixels up to each sample's end
+    px = np.compress(usable, px, axis=0)  # = px[usable], in order: each sample's pixels stay together
+    out: List[Optional[np.ndarray]] = []
+    j, start = 0, 0
+    for s in samples:
+        if s is None:
+            out.append(None)
+            continue
+        stop = kept[j]
+        j += 1
+        out.append(median_rows(px[start:stop]) if stop - start >= MIN_WHITE_PX else None)
+        start = stop
+    return out
 
 
 def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float = 2.0) -> Optional[Gains]:
@@ -133,7 +158,7 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
     candidate's "white body" (a pale bumper, a wall) is near-neutral too, and
     one landmark out of three cannot move a median.
     """
-    colours = [col for col in (white_body_colour(bgr, c) for c in cands) if col is not None]
+    colours = [col for col in _body_colours(bgr, cands) if col is not None]
     if not colours:
         return None
     # np.median's value by a partial sort (core/stats.py): np.median imports numpy.ma at a process's first call
