@@ -124,3 +124,26 @@ def test_under_a_strong_cast_half_the_correction_is_searched_too():
     seen.clear()
     balanced_search(find, img, (1.1, 1.0, 0.92), 8)  # a mild cast: grey-world and the camera's balance only
     assert len(seen) == 2
+
+
+def test_other_balances_are_not_searched_when_the_first_found_landmarks_explaining_all_it_saw():
+    from rangebearing.core.structure import Found
+
+    img, c = frame_with_body((150, 150, 150))
+    seen = []
+
+    def find(all_explained, landmarks):
+        def run(gains):
+            seen.append(gains)
+            return Found(landmarks, lambda: all_explained)
+        return run
+
+    grey = (0.71, 1.13, 1.35)  # a strong cast: three balances would be searched
+    cands, _ = balanced_search(find(True, [c]), img, grey, 8)
+    assert cands == [c] and seen == [grey]
+    seen.clear()
+    balanced_search(find(False, [c]), img, grey, 8)  # something of a band's colour is unexplained
+    assert seen == [grey, (1.0, 1.0, 1.0), halfway(grey)]
+    seen.clear()
+    balanced_search(find(True, []), img, grey, 8)  # nothing found: every balance, as before
+    assert len(seen) == 3

@@ -175,3 +175,26 @@ def test_a_dark_chassis_between_a_red_box_and_a_blue_mat_is_no_white_body():
     img[30:54, 50:71] = (50, 50, 50)  # ... a dark robot chassis (grey enough for the white class) ...
     img[54:64, 50:71] = BLUE  # ... and a blue mat: the shape of a landmark, but no white body
     assert search(img) == []
+
+
+def test_a_search_explains_its_regions_only_when_every_one_is_a_found_landmarks_band():
+    from rangebearing.core.structure import search as structure_search
+
+    def found(img):
+        hsv = to_hsv(img)
+        red = ((hsv[..., 0] < 10) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+        blue = ((hsv[..., 0] > 98) & (hsv[..., 0] < 132) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+        return structure_search(red, blue, hsv, 1, GEOMETRY, 16)
+
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    landmark(img, 50, 20, 9, 21)
+    f = found(img)
+    assert len(f.candidates) == 1 and f.explained()
+    img[90:100, 120:140] = RED  # a red box the landmark does not explain
+    f = found(img)
+    assert len(f.candidates) == 1 and not f.explained()
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    img[20:29, 50:71] = RED  # a red band with no white body under these gains: a band, no landmark
+    img[53:62, 50:71] = BLUE
+    f = found(img)
+    assert f.candidates == [] and not f.explained()

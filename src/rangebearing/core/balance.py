@@ -24,13 +24,13 @@ statistics, but both leave a landmark findable under one of the two. So:
 
 from __future__ import annotations
 
-from typing import Callable, List, Optional, Sequence, Tuple
+from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from .color import CLIPPED, DARK, UNIT_GAINS, Gains
 from .stats import median_rows
-from .structure import Candidate
+from .structure import Candidate, Found
 
 NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
 TALLER = 1.15  # of one landmark found twice, a white body this much taller is the landmark's whole
@@ -168,20 +168,34 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
 
 
 def balanced_search(
-    find: Callable[[Gains], List[Candidate]], bgr: np.ndarray, gains: Gains, max_landmarks: int
+    find: Callable[[Gains], Union[List[Candidate], Found]], bgr: np.ndarray, gains: Gains, max_landmarks: int
 ) -> Tuple[List[Candidate], Gains]:
     """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too
     (under a strong cast also :func:`halfway` between them); and the gains to measure them with:
     their white bodies', else ``gains``.
 
-    ``find(gains)`` is the structure search of this frame (BGR or YUV path).
+    ``find(gains)`` is the structure search of this frame (BGR or YUV path): its candidates, or a
+    :class:`.structure.Found`. When the grey-world search found landmarks that explain every red and
+    blue region it saw, the other balances are not searched: what they could add is a landmark
+    whose bands are among those regions (its body not white under these gains, a smaller piece of it
+    found, a neighbour merged with it), and there is none. A frame with nothing found, or with
+    band-coloured things no candidate explains, is searched under every balance as before.
     """
-    cands = find(gains)
-    if not near_unit(gains):
-        cands = merge_candidates(cands, find(UNIT_GAINS), max_landmarks)
-    if not near_unit(gains, STRONG_CAST):
-        cands = merge_candidates(cands, find(halfway(gains)), max_landmarks)
+    first = find(gains)
+    if isinstance(first, Found):
+        cands = first.candidates
+        done = bool(cands) and first.explained()
+    else:
+        cands, done = first, False
+    if not near_unit(gains) and not done:
+        cands = merge_candidates(cands, _candidates(find(UNIT_GAINS)), max_landmarks)
+    if not near_unit(gains, STRONG_CAST) and not done:
+        cands = merge_candidates(cands, _candidates(find(halfway(gains))), max_landmarks)
     return cands, white_body_gains(bgr, cands) or gains
+
+
+def _candidates(found: Union[List[Candidate], Found]) -> List[Candidate]:
+    return found.candidates if isinstance(found, Found) else found
 
 
 def halfway(gains: Gains) -> Gains:

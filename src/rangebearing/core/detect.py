@@ -32,7 +32,7 @@ from .denoise import band_masks, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
-from .structure import Candidate, candidates
+from .structure import Candidate, Found, search
 from .types import XY, BBox, LandmarkGeometry, union
 from .uncertainty import row_spread_px
 
@@ -99,11 +99,18 @@ def find_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
 ) -> List[Candidate]:
     """Landmark candidates in a frame downscaled by ``cfg.downscale`` (see :mod:`.structure`)."""
+    return search_candidates(small, cfg, gains, ksize, geometry).candidates
+
+
+def search_candidates(
+    small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
+) -> Found:
+    """:func:`find_candidates` and whether they explain every band-coloured region (:func:`.structure.search`)."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
-    return candidates(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
+    return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 
 
 def refine(

@@ -22,7 +22,7 @@ import numpy as np
 from .balance import balanced_search
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import band_preserving_ksize
-from .detect import BandCentroids, detect_paper, downscale, drop_stacked, find_candidates, refine
+from .detect import BandCentroids, detect_paper, downscale, drop_stacked, refine, search_candidates
 from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
@@ -32,12 +32,12 @@ from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .scans import crossing, rescanned
-from .structure import Candidate
+from .structure import Found
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
 from .uncertainty import chroma_blur_all, chroma_blur_px, reading_sigma
 from .verify import verified
-from .yuv import Yuv420, half_luma, yuv_find_candidates, yuv_grey_world_gains
+from .yuv import Yuv420, half_luma, yuv_grey_world_gains, yuv_search
 
 SEARCH_RANGE_M = 2.2  # the farthest landmark the full-frame search must keep (issue 8: at least 2 m)
 # no reading beyond this: the search is built for landmarks out to SEARCH_RANGE_M, and a red-white-blue
@@ -160,17 +160,17 @@ class Pipeline:
                 y_half = half_luma(yuv.y) if yuv is not None else None
                 geometry = self.params.landmark
 
-                def find(gains: Gains) -> List[Candidate]:
+                def find(gains: Gains) -> Found:
                     if yuv is None:
-                        return find_candidates(small, det, gains, ksize, geometry)
-                    return yuv_find_candidates(yuv, det, gains, ksize, geometry, y_half)
+                        return search_candidates(small, det, gains, ksize, geometry)
+                    return yuv_search(yuv, det, gains, ksize, geometry, y_half)
 
                 if det.white_balance == "grey_world":
                     grey = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
                     # measured with the gains of the landmarks' own white bodies (see core/balance.py)
                     cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks)
                 else:
-                    cands = find(self._gains)
+                    cands = find(self._gains).candidates
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 # no landmark without a landmark's properties, nor away from where landmarks stand

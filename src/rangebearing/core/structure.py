@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import List, Optional, Tuple
+from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -120,6 +120,57 @@ def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
     return seg.size > 0 and 255 * np.count_nonzero(seg) > 127 * seg.size  # mean > 127 of a 0/255 mask
 
 
+def search(
+    red: np.ndarray,
+    blue: np.ndarray,
+    hsv: np.ndarray,
+    scale: int,
+    geometry: LandmarkGeometry,
+    max_landmarks: int,
+    min_area: int = 2,
+) -> Found:
+    """:func:`candidates` and whether they explain every red and blue region of the masks (:func:`explained`,
+    judged only when asked)."""
+    reds, blues = region_stats(red, min_area), region_stats(blue, min_area)
+    found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks)
+    return Found(found, functools.partial(explained, reds, blues, found, scale))
+
+
+class Found(NamedTuple):
+    """A structure search's candidates and ``explained()``: whether they explain all it saw."""
+
+    candidates: List[Candidate]
+    explained: Callable[[], bool]
+
+
+EXPLAIN_MARGIN = 0.25  # a region within this share of a band box's size (and 2 mask pixels) beyond it is that band's
+
+
+def explained(reds: np.ndarray, blues: np.ndarray, found: Sequence[Candidate], scale: int) -> bool:
+    """Whether every red and blue region (:func:`region_stats` rows, mask pixels) lies within a band box of
+    its colour of some candidate (full-resolution pixels), grown by ``EXPLAIN_MARGIN`` and 2 mask pixels.
+
+    A region no candidate explains is something else of a band's colour, or a band the search did not
+    make into a landmark (its white body not white under these gains, a smaller piece of it found, a
+    neighbour merged with it): a search under another balance may find more there.
+    """
+    for regions, boxes in ((reds, [c.red_bbox_px for c in found]), (blues, [c.blue_bbox_px for c in found])):
+        if not len(regions):
+            continue
+        if not boxes:
+            return False
+        b = np.asarray(boxes, np.float64) / scale
+        mx = np.maximum(2.0, EXPLAIN_MARGIN * b[:, 2])
+        my = np.maximum(2.0, EXPLAIN_MARGIN * b[:, 3])
+        x0, y0, x1, y1 = b[:, 0] - mx, b[:, 1] - my, b[:, 0] + b[:, 2] + mx, b[:, 1] + b[:, 3] + my
+        rx0, ry0 = regions[:, 1, None], regions[:, 2, None]
+        rx1, ry1 = rx0 + regions[:, 3, None], ry0 + regions[:, 4, None]
+        inside = (rx0 >= x0) & (ry0 >= y0) & (rx1 <= x1) & (ry1 <= y1)
+        if not inside.any(axis=1).all():
+            return False
+    return True
+
+
 def candidates(
     red: np.ndarray,
     blue: np.ndarray,
@@ -137,7 +188,13 @@ def candidates(
     ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
     pairs per landmark wanted are examined, whatever the frame holds.
     """
-    reds, blues = region_stats(red, min_area), region_stats(blue, min_area)
+    return _candidates(region_stats(red, min_area), region_stats(blue, min_area), red, blue, hsv, scale, geometry,
+                       max_landmarks)
+
+
+def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.ndarray, hsv: np.ndarray, scale: int,
+                geometry: LandmarkGeometry, max_landmarks: int) -> List[Candidate]:
+    """:func:`candidates` from the masks' regions (:func:`region_stats` of ``red`` and ``blue``)."""
     white_h = geometry.height_m - 2 * geometry.band_height_m
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
     out: List[Candidate] = []

@@ -31,7 +31,7 @@ from .._compat import frozen
 from .color import UNIT_GAINS, Gains, grey_world_gains, to_hsv
 from .denoise import band_masks
 from .params import DetectionParams
-from .structure import Candidate, candidates
+from .structure import Candidate, Found, search
 from .types import LandmarkGeometry
 
 # Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
@@ -257,8 +257,16 @@ def yuv_find_candidates(
     ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
     full-resolution pixels of the frame the planes belong to.
     """
+    return yuv_search(yuv, cfg, gains, ksize, geometry, y_half).candidates
+
+
+def yuv_search(
+    yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
+    y_half: Optional[np.ndarray] = None,
+) -> Found:
+    """:func:`yuv_find_candidates` and whether they explain every band-coloured region (:func:`.structure.search`)."""
     y_half = half_luma(yuv.y) if y_half is None else y_half
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
-    return candidates(red, blue, WindowHsv(y_half, yuv, gains), 2, geometry, cfg.max_landmarks, min_area)
+    return search(red, blue, WindowHsv(y_half, yuv, gains), 2, geometry, cfg.max_landmarks, min_area)
