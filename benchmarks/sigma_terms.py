@@ -1,0 +1,142 @@
+"""What makes each reading's sigma, set by set: 2σ cover, each term's share of σ², and cover under other shares.
+
+Usage::
+
+    python benchmarks/sigma_terms.py SET_DIR[:track] ... --config cal.yaml [--share NAME=VALUE ...]
+
+Replays every ``SET_DIR`` (a folder written by ``rangebearing synth``; ``:track`` replays it with
+tracking, as ``crowd-moving`` is measured) and keeps, for every reading matched to its truth, the
+inputs :func:`rangebearing.core.uncertainty.reading_sigma` was given. Per set (the folder name up
+to ``-s<seed>``, seeds pooled) it prints:
+
+* the 2σ cover in range and bearing (issue 8: 90–98 %) and the factor ``p95(|error|/σ)/2`` by which
+  that set's σ would have to be scaled for 95 % (below 1: σ too wide);
+* each term's mean share of the reading's σ² (the term's constant set to 0, the rest kept): range
+  ``noise`` (NOISE_SHARE), ``spread`` (SPREAD_SHARE: the row estimators' disagreement, merged bands
+  included), ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
+  ``floor`` (EDGE_FLOOR_PX, MODEL_FLOOR); bearing ``column``, ``spread``, ``shading``, ``hidden``,
+  ``cut``, ``floor``.
+
+``--share NAME=VALUE`` (a constant of ``core/uncertainty.py``, e.g. ``SPREAD_SHARE=0.7``; repeatable)
+recomputes every sigma from the kept inputs with that value and prints the cover again, so a re-fit
+can be tried on many sets without replaying them. Terms measured inside the detector
+(``MERGED_PX`` in the spread, the inputs themselves) are not re-evaluated.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+from collections import defaultdict
+from typing import Dict, List, Optional, Sequence, Tuple
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np
+
+from rangebearing import Pipeline, load_config
+from rangebearing.cli.common import aligned_truth
+from rangebearing.core import pipeline as pipeline_module
+from rangebearing.core import uncertainty as u
+from rangebearing.evaluation.match import match_frame
+from rangebearing.sources.recorded import iter_recorded
+
+RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "blur": ("CHROMA_SHARE",),
+               "hidden": ("HIDDEN_SHARE_L",), "cut": ("CUT_SHARE_L", "SPLIT_SHARE_L"),
+               "floor": ("EDGE_FLOOR_PX", "MODEL_FLOOR")}
+BEARING_TERMS = {"column": ("COLUMN_SHARE",), "spread": ("SPREAD_X_SHARE",), "shading": ("SHADING_SHARE",),
+                 "hidden": ("HIDDEN_SHARE",), "cut": ("CUT_SHARE", "SPLIT_SHARE"), "floor": ("BEARING_FLOOR_RAD",)}
+
+
+def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, float, float]]:
+    """``(reading_sigma's arguments, its keywords, true range, true bearing)`` of every matched reading."""
+    kept: List[tuple] = []
+    original = pipeline_module.reading_sigma
+
+    def keeping(*args, **kwargs):  # the pipeline's own call, its inputs kept
+        out = original(*args, **kwargs)
+        kept.append((args, kwargs, out))
+        return out
+
+    truth = aligned_truth(folder, os.path.join(folder, "truth.csv"))
+    pipe = Pipeline(load_config(config).pipeline, track=tracked)
+    rows = []
+    pipeline_module.reading_sigma = keeping
+    try:
+        for name, image in iter_recorded(folder):
+            kept.clear()
+            found = pipe.process(image).landmarks
+            matches, _ = match_frame(name, found, truth.get(name, []))
+            for m in matches:
+                if m.found is None:
+                    continue
+                for args, kwargs, _out in kept:  # args[0], args[1]: the reading's range and bearing
+                    if args[0] == m.found.range_m and args[1] == m.found.bearing_rad:
+                        rows.append((args, kwargs, m.truth.range_m, m.truth.bearing_rad))
+                        break
+    finally:
+        pipeline_module.reading_sigma = original
+    return rows
+
+
+def sigmas(rows: Sequence[tuple], zero: Sequence[str] = ()) -> np.ndarray:
+    """``(n, 2)`` range and bearing sigma of the kept readings, with the constants in ``zero`` set to 0."""
+    saved = {name: getattr(u, name) for name in zero}
+    try:
+        for name in zero:
+            setattr(u, name, 0.0)
+        return np.array([u.reading_sigma(*args, **kwargs) for args, kwargs, _, _ in rows]).reshape(-1, 2)
+    finally:
+        for name, value in saved.items():
+            setattr(u, name, value)
+
+
+def report(sets: Dict[str, List[tuple]]) -> None:
+    """Cover, scale for 95 % and the terms' shares of σ², one line per set and quantity."""
+    for name in sorted(sets):
+        rows = sets[name]
+        err = np.array([[abs(a[0] - tr), abs(a[1] - tb)] for a, _, tr, tb in rows]).reshape(-1, 2)
+        s = sigmas(rows)
+        z = err / np.maximum(s, 1e-12)
+        for k, (label, terms) in enumerate((("range", RANGE_TERMS), ("bearing", BEARING_TERMS))):
+            shares = []
+            for term, consts in terms.items():
+                without = sigmas(rows, consts)[:, k]
+                shares.append(f"{term} {np.mean(1.0 - (without / np.maximum(s[:, k], 1e-12)) ** 2):.2f}")
+            cover = 100.0 * np.mean(z[:, k] <= 2.0)
+            flag = "" if 90.0 <= cover <= 98.0 else " x"
+            print(f"{name:16s} {label:7s} n={len(rows):4d} cover {cover:5.1f} %{flag:2s} scale "
+                  f"{np.percentile(z[:, k], 95) / 2:.2f}  shares: {', '.join(shares)}")
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("folders", nargs="+", metavar="SET_DIR[:track]")
+    p.add_argument("--config", required=True)
+    p.add_argument("--share", action="append", default=[], metavar="NAME=VALUE",
+                   help="recompute the sigmas with this constant of core/uncertainty.py")
+    args = p.parse_args(argv)
+    changes = {}
+    for item in args.share:
+        name, _, value = item.partition("=")
+        if not hasattr(u, name) or not isinstance(getattr(u, name), float):
+            p.error(f"--share {item}: core/uncertainty.py has no float constant {name!r}")
+        changes[name] = float(value)
+    sets: Dict[str, List[tuple]] = defaultdict(list)
+    for spec in args.folders:
+        folder, _, mode = spec.partition(":")
+        base = os.path.basename(os.path.normpath(folder))
+        sets[re.sub(r"-s\d+-.*$", "", base)].extend(replay(folder, args.config, mode == "track"))
+    print("as configured:")
+    report(sets)
+    if changes:
+        for name, value in changes.items():
+            setattr(u, name, value)
+        print("with " + ", ".join(f"{k}={v:g}" for k, v in changes.items()) + ":")
+        report(sets)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
