@@ -168,7 +168,8 @@ def combine(
     if rows is None:
         return None
     # the band spacing and the white body's height are two measures of one size: they must agree
-    spacing_px = _y(blue.xy_px[1], rows.blue_y_px, rows.blue_merged) - _y(red.xy_px[1], rows.red_y_px, rows.red_merged)
+    red_y, blue_y = rows.band_y(True, red.xy_px[1]), rows.band_y(False, blue.xy_px[1])
+    spacing_px = blue_y - red_y
     expected_px = rows.white_px * geometry.band_spacing_m / (geometry.height_m - 2 * geometry.band_height_m)
     if not SPACING_AGREE[0] <= spacing_px / max(expected_px, 1e-6) <= SPACING_AGREE[1]:
         return None
@@ -184,8 +185,8 @@ def combine(
         x_r = x_b = cols[0]
         sx = cols[1]
     return BandCentroids(
-        (x_r, _y(red.xy_px[1], rows.red_y_px, rows.red_merged)),
-        (x_b, _y(blue.xy_px[1], rows.blue_y_px, rows.blue_merged)),
+        (x_r, red_y),
+        (x_b, blue_y),
         c.red_bbox_px,
         c.blue_bbox_px,
         red.mass_px,
@@ -200,14 +201,6 @@ def combine(
         candidate=c,
         moments_px=(red.xy_px, blue.xy_px),
     )
-
-
-def _y(moment_y: float, edge_y: float, merged: bool) -> float:
-    """A band's row: the mean of its moment and its edges' midpoint, or its edge-based row when merged."""
-    # the two are partly independent (gamma-space chroma moments, linear-light edges): their mean beats
-    # either on backlit far landmarks (dev far seeds); the edges alone do better under a camera's chroma
-    # bleed (photoreal: the moment ran 1-1.7 % long in L), the edges' luma correction keeps most of that
-    return edge_y if merged else 0.5 * (moment_y + edge_y)
 
 
 def detect_paper(bgr: np.ndarray, cfg: DetectionParams) -> List[BandCentroids]:

@@ -33,6 +33,8 @@ MISFIT_SLACK = 0.05  # the luma may spoil the proportion by this much (band heig
 BLED_PX = 0.25  # a luma inner edge this far from the chroma one shows the camera bleeds chroma
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
+BAND_FIT = 0.15  # a band whose edges span 15/40 of the white height within this share fits (Rows.band_y)
+RUN_SLACK_PX = 2  # a band's run of strong colour may be this much longer than the band (blur)
 
 
 @frozen
@@ -42,7 +44,11 @@ class Rows:
     ``red_merged``/``blue_merged``: the band is placed from its inner edge and the
     white height, because its outer edge is not its own (merged with a background
     of its colour, or hidden). ``red_px``/``blue_px``: each band's height between
-    its two measured edges (NaN when merged).
+    its two measured edges (NaN when merged). ``red_luma``/``blue_luma``: its inner
+    edge was taken from luma (the camera bleeds chroma into the white body).
+    ``red_fits``/``blue_fits``: its edges span 15/40 of the white height within
+    ``BAND_FIT`` (always for a merged band, placed from that height): :meth:`band_y`
+    then takes the edges' row alone.
     """
 
     red_y_px: float
@@ -53,6 +59,24 @@ class Rows:
     blue_merged: bool
     red_px: float = math.nan
     blue_px: float = math.nan
+    red_luma: bool = False
+    blue_luma: bool = False
+    red_fits: bool = True
+    blue_fits: bool = True
+
+    def band_y(self, red: bool, moment_y_px: float) -> float:
+        """The band's row (full-resolution pixels): its edges' row where its edges fit the landmark,
+        else the mean of that and the band's moment ``moment_y_px``.
+
+        The edges' row beats the chroma moment wherever the band's edges are its own: a camera's
+        chroma bleed pulls the moment into the bright white body (L 1-1.7 % short under the
+        photoreal camera) and a dark, faintly tinted thing beyond the band pulls it out. Where a
+        band's two edges span a height off the landmark's 15/40, one of them is not the band's
+        (a shadow, a fringe, a neighbour's part): the moment, measured another way, halves that
+        error.
+        """
+        edge_y, fits = (self.red_y_px, self.red_fits) if red else (self.blue_y_px, self.blue_fits)
+        return edge_y if fits else 0.5 * (moment_y_px + edge_y)
 
 
 def measure_rows(
@@ -170,11 +194,13 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     k = 0.5 * geometry.band_height_m / white_m
     if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
         blue = _hidden(blue, _height(red, True) or 2 * k * white)
+    luma = (False, False)
     if lu is not None and not (red.merged and blue.merged):
         l_red, l_blue, l_white = _luma_edges(mean_along(lu, 1), red, blue, 2 * k * white)
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
         if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
+            luma = (l_red.inner != red.inner, l_blue.inner != blue.inner)
             red, blue, white = l_red, l_blue, l_white
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
@@ -188,7 +214,17 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         blue.merged,
         math.nan if red.merged else 2.0 * (red.inner - red.centre) * f,
         math.nan if blue.merged else 2.0 * (blue.centre - blue.inner) * f,
+        luma[0],
+        luma[1],
+        _fits(red, True, 2 * k * white),
+        _fits(blue, False, 2 * k * white),
     )
+
+
+def _fits(band: BandEdges, red: bool, expected_px: float) -> bool:
+    """Whether a band's edges span ``expected_px`` (15/40 of the white height) within ``BAND_FIT``; a merged
+    band, placed from that height, always does."""
+    return band.merged or abs(_height(band, red) - expected_px) <= BAND_FIT * expected_px
 
 
 def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
@@ -274,13 +310,25 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
         first -= 1
     while last < len(prof) - 1 and strong[last + 1]:
         last += 1
-    mid = lo + (first + last) // 2
     half = max(0, int(0.5 * hb - 1.5))
     into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther
     beyond = round(0.5 * hb + 3)
-    if red:
-        return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p, column_sigma)
-    return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p, column_sigma)
+
+    def measured(mid: int) -> Optional[BandEdges]:
+        if red:
+            return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p, column_sigma)
+        return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p, column_sigma)
+
+    band = measured(lo + (first + last) // 2)
+    # a run much longer than a band that ends merged may hold a background of the band's hue beyond its outer
+    # edge (behind a backlit, dark band it can reach half the band's level): the run's centre then sits off
+    # the band, its level is read half on that background and its inner edge a row into the white body.
+    # The band's own rows are then the band's height of the run next to the body
+    if band is not None and band.merged and last - first + 1 > hb + RUN_SLACK_PX:
+        size = int(hb + 0.5)
+        anchored = measured(lo + ((2 * last - size + 1) if red else (2 * first + size - 1)) // 2)
+        band = anchored if anchored is not None else band
+    return band
 
 
 __all__ = [
