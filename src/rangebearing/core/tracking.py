@@ -56,9 +56,9 @@ class Track:
 def _origin(t: Track) -> Tuple[XY, XY]:
     """The (red, blue) points to move the boxes from: the moments last measured, so a box moves as its moments move.
 
-    A band's row is the mean of its moment and its edges (:func:`.detect.combine`):
-    moving the box by the moment's step from that mean would add half their
-    difference to the box every frame, and the box would walk off the band.
+    A band's row comes from its edges, or their mean with its moment (:func:`.measure.Rows.band_y`):
+    moving the box by the moment's step from that row would add their difference
+    (or half of it) to the box every frame, and the box would walk off the band.
     """
     if t.moments_px is not None:
         return t.moments_px
