@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from rangebearing.core.edges import excess_luma, luma_inner
+from rangebearing.core.edges import edge_down, excess_luma, luma_inner
 from rangebearing.core.measure import _rows, measure_rows
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
@@ -78,3 +78,32 @@ def test_a_luma_edge_far_from_the_chroma_one_is_not_taken():
     p = _luma_profile(23.3)
     assert luma_inner(p, 20.3, True, 8.0) is None
     assert luma_inner(_luma_profile(20.3, band=0.7), 20.3, True, 8.0) is None  # no luma step at all
+
+
+def _sharpened(edge, band=0.1, white=0.4, n=40):
+    """Band luma above row ``edge``, the white body below, blurred by the lens (0.5 px) and sharpened
+    by the camera (unsharp mask, amount 2, radius 1 px): a bright lobe beside the edge on the body's
+    side, a dark one on the band's."""
+    ss = 16
+    y = (np.arange(n * ss) + 0.5) / ss - 0.5
+    f = cv2.GaussianBlur(np.where(y < edge, band, white).astype(np.float32).reshape(-1, 1), (0, 0), 0.5 * ss)
+    p = f.reshape(n, ss).mean(axis=1)
+    return (p + 2.0 * (p - cv2.GaussianBlur(p.reshape(-1, 1), (0, 0), 1.0).ravel())).astype(np.float32)
+
+
+@pytest.mark.parametrize("edge", [20.0, 20.25, 20.5, 20.75])
+def test_a_sharpened_luma_edge_is_its_half_level_crossing(edge):
+    # lobes of ~20 % of the step: the two-level integral over the window (which holds them unevenly) put
+    # the edge up to 0.17 row into the band; the crossing of the half level stays within a tenth of a row
+    p = _sharpened(edge)
+    a, z = round(edge + 0.8 - 4), round(edge + 0.8 + 4)
+    integral = edge_down(p, a, z, float(p[a - 1 : a + 2].mean()), float(p[z : z + 4].mean()))
+    assert luma_inner(p, edge + 0.8, True, 8.0) == pytest.approx(edge, abs=0.1)
+    assert abs(luma_inner(p, edge + 0.8, True, 8.0) - edge) < abs(integral - edge)
+    q = p[::-1].copy()  # the blue band's inner edge: the body above it
+    assert luma_inner(q, 39 - edge - 0.8, False, 8.0) == pytest.approx(39 - edge, abs=0.1)
+
+
+def test_an_unsharpened_luma_edge_stays_the_two_level_integral():
+    p = _luma_profile(20.3)  # no lobes: the integral is exact, the crossing of linear interpolation is not
+    assert luma_inner(p, 20.8, True, 8.0) == pytest.approx(20.3, abs=1e-4)

@@ -1,5 +1,6 @@
 """Columns of landmarks cut at one side: limbs and outline centres (core/measure.py, core/edges.limb)."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -7,7 +8,7 @@ import pytest
 
 from rangebearing import Pipeline, load_config
 from rangebearing.core.edges import limb
-from rangebearing.core.measure import measure_rows, outline_centre
+from rangebearing.core.measure import _band, measure_rows, outline_centre
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
 from rangebearing.synth import Imaging, LandmarkPose, Scene, render
@@ -97,3 +98,23 @@ def test_a_blue_band_hidden_from_below_is_placed_from_its_inner_edge(hidden_rows
     rows = measure_rows(_strips(hidden_rows), _candidate(), (1.0, 1.0, 1.0), GEOMETRY, 39.5)
     assert rows.blue_merged
     assert rows.blue_y_px == pytest.approx(82.0, abs=0.1)
+
+
+def test_a_band_whose_edges_fit_the_landmark_takes_its_edges_row_else_the_mean_with_its_moment():
+    rows = measure_rows(_strips(), _candidate(), (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert rows.red_fits and rows.blue_fits
+    assert rows.band_y(True, 30.0) == rows.red_y_px and rows.band_y(False, 80.0) == rows.blue_y_px
+    off = dataclasses.replace(rows, red_px=0.7 * rows.red_px, red_fits=False)
+    assert off.band_y(True, 30.0) == pytest.approx(0.5 * (30.0 + rows.red_y_px))
+
+
+def test_a_dark_band_before_a_background_of_half_its_level_is_measured_on_its_own_rows():
+    # a backlit red band (level 0.68) under a warm wall whose red excess is half of it (0.35): the band's run
+    # of strong colour runs through the wall; seeded on the run's centre the band read as merged, its level
+    # half the wall's and its inner edge a row into the white body
+    p = np.zeros(40, np.float32)
+    p[:14] = 0.35
+    p[14:20] = 0.68  # the band: rows 14-19, inner edge at 19.5
+    p2d = np.repeat(p[:, None], 8, axis=1)
+    band = _band(p2d, p, 16.5, 5.25, 14.0, True, False)
+    assert band.inner == pytest.approx(19.5, abs=0.05)
