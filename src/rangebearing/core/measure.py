@@ -302,6 +302,7 @@ def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float,
     # seed on the band-sized run of strongest colour, not the strongest row: a bright background
     # beyond the outer edge leaves a one-row demosaic fringe that can beat the band's own level
     k = max(1, int(0.5 * hb + 0.5))
+    k = min(k, len(prof))  # a tile cut short at the frame edge: np.convolve "same" returns the longer length
     smooth = np.convolve(prof, _box(k), mode="same") if k > 1 else prof
     top = int(np.argmax(smooth))
     strong = prof >= 0.5 * smooth[top]
