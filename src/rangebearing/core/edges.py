@@ -225,9 +225,7 @@ def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: boo
     The luma edge is the two-level integral, unless the luma beside it overshoots either level
     by more than ``LUMA_RING`` of the step: a camera's sharpening puts a bright lobe on one side
     and a dark one on the other, which move the levels and, unless both lie wholly inside the
-    window, the integral; the half-level crossing stays where the edge is. (Dev, cal multi
-    5151, pooled range mean/p95 %: photoreal 0.69/2.00 -> 0.64/1.90, photoreal-crowd
-    0.82/2.68 -> 0.78/2.52, rooms 0.68/2.05 -> 0.66/1.98; the clean renders do not ring.)
+    window, the integral; the half-level crossing stays where the edge is (the clean renders do not ring).
     """
     n = len(p)
     s = 1 if down else -1
