@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from rangebearing import Pipeline, load_config
+from rangebearing.core.band_seed import seeded_band
 from rangebearing.core.edges import limb
-from rangebearing.core.measure import _band, measure_rows, outline_centre
+from rangebearing.core.measure import measure_rows, outline_centre
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
 from rangebearing.synth import Imaging, LandmarkPose, Scene, render
@@ -116,5 +117,5 @@ def test_a_dark_band_before_a_background_of_half_its_level_is_measured_on_its_ow
     p[:14] = 0.35
     p[14:20] = 0.68  # the band: rows 14-19, inner edge at 19.5
     p2d = np.repeat(p[:, None], 8, axis=1)
-    band = _band(p2d, p, 16.5, 5.25, 14.0, True, False)
+    band = seeded_band(p2d, p, 16.5, 5.25, 14.0, True, False)
     assert band.inner == pytest.approx(19.5, abs=0.05)

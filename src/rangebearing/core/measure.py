@@ -16,15 +16,15 @@ placed from its other limb.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
+from .band_seed import seeded_band as _band
 from .color import Gains
-from .edges import BandEdges, band_rows, excess_luma, luma_edge, mean_along
+from .edges import BandEdges, excess_luma, luma_edge, mean_along
 from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_centre, thin_step
 from .structure import Candidate
 from .types import LandmarkGeometry
@@ -34,7 +34,6 @@ BLED_PX = 0.25  # a luma inner edge this far from the chroma one shows the camer
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
 BAND_FIT = 0.15  # a band whose edges span 15/40 of the white height within this share fits (Rows.band_y)
-RUN_SLACK_PX = 2  # a band's run of strong colour may be this much longer than the band (blur)
 
 
 @frozen
@@ -281,55 +280,6 @@ def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
         return blue
     return dataclasses.replace(blue, merged=True)
-
-
-@functools.lru_cache(maxsize=64)
-def _box(k: int) -> np.ndarray:
-    """The ``k``-row box kernel of :func:`_band` (float32, read-only)."""
-    box = np.full(k, 1.0 / k, np.float32)
-    box.flags.writeable = False
-    return box
-
-
-def _band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool,
-          column_sigma: bool = True):
-    """:func:`.edges.band_rows` around the row of strongest colour near ``expected`` (``p``: the row profile)."""
-    n = p2d.shape[0]
-    lo, hi = max(0, int(expected - 0.5 * hb - 3)), min(n, int(expected + 0.5 * hb + 4))
-    if hi <= lo:
-        return None
-    prof = p[lo:hi]  # rows' means do not depend on the other rows
-    # seed on the band-sized run of strongest colour, not the strongest row: a bright background
-    # beyond the outer edge leaves a one-row demosaic fringe that can beat the band's own level
-    k = max(1, int(0.5 * hb + 0.5))
-    k = min(k, len(prof))  # a tile cut short at the frame edge: np.convolve "same" returns the longer length
-    smooth = np.convolve(prof, _box(k), mode="same") if k > 1 else prof
-    top = int(np.argmax(smooth))
-    strong = prof >= 0.5 * smooth[top]
-    first, last = top, top  # the band's rows: the run of strong colour around the strongest row
-    while first > 0 and strong[first - 1]:
-        first -= 1
-    while last < len(prof) - 1 and strong[last + 1]:
-        last += 1
-    half = max(0, int(0.5 * hb - 1.5))
-    into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther
-    beyond = round(0.5 * hb + 3)
-
-    def measured(mid: int) -> Optional[BandEdges]:
-        if red:
-            return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p, column_sigma)
-        return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p, column_sigma)
-
-    band = measured(lo + (first + last) // 2)
-    # a run much longer than a band that ends merged may hold a background of the band's hue beyond its outer
-    # edge (behind a backlit, dark band it can reach half the band's level): the run's centre then sits off
-    # the band, its level is read half on that background and its inner edge a row into the white body.
-    # The band's own rows are then the band's height of the run next to the body
-    if band is not None and band.merged and last - first + 1 > hb + RUN_SLACK_PX:
-        size = int(hb + 0.5)
-        anchored = measured(lo + ((2 * last - size + 1) if red else (2 * first + size - 1)) // 2)
-        band = anchored if anchored is not None else band
-    return band
 
 
 __all__ = [

@@ -1,0 +1,71 @@
+"""Where a band's rows are in its row profile: the band-sized run of strongest colour, next to the body.
+
+:func:`.edges.band_rows` measures a band's edges from rows known to lie inside it; this finds
+those rows in a profile that may also hold a background of the band's hue beyond its outer
+edge, a bright background's demosaic fringe, or a neighbour's part.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Optional
+
+import numpy as np
+
+from .edges import BandEdges, band_rows
+
+RUN_SLACK_PX = 2  # a band's run of strong colour may be this much longer than the band (blur)
+
+
+@functools.lru_cache(maxsize=64)
+def box_kernel(k: int) -> np.ndarray:
+    """The ``k``-row box kernel of :func:`seeded_band` (float32, read-only)."""
+    box = np.full(k, 1.0 / k, np.float32)
+    box.flags.writeable = False
+    return box
+
+
+def seeded_band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: float, red: bool,
+                column_sigma: bool = True) -> Optional[BandEdges]:
+    """:func:`.edges.band_rows` of one band around its rows of strongest colour near ``expected``.
+
+    ``p2d``: the band's weighted excess tile (rows, columns), ``p`` its row profile; ``hb``/``hw``:
+    the band's and the white body's expected heights (rows); ``red``: the white body lies below.
+    ``None`` when the band shows no colour step at the body.
+    """
+    n = p2d.shape[0]
+    lo, hi = max(0, int(expected - 0.5 * hb - 3)), min(n, int(expected + 0.5 * hb + 4))
+    if hi <= lo:
+        return None
+    prof = p[lo:hi]  # rows' means do not depend on the other rows
+    # seed on the band-sized run of strongest colour, not the strongest row: a bright background
+    # beyond the outer edge leaves a one-row demosaic fringe that can beat the band's own level
+    k = max(1, int(0.5 * hb + 0.5))
+    k = min(k, len(prof))  # a tile cut short at the frame edge: np.convolve "same" returns the longer length
+    smooth = np.convolve(prof, box_kernel(k), mode="same") if k > 1 else prof
+    top = int(np.argmax(smooth))
+    strong = prof >= 0.5 * smooth[top]
+    first, last = top, top  # the band's rows: the run of strong colour around the strongest row
+    while first > 0 and strong[first - 1]:
+        first -= 1
+    while last < len(prof) - 1 and strong[last + 1]:
+        last += 1
+    half = max(0, int(0.5 * hb - 1.5))
+    into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther
+    beyond = round(0.5 * hb + 3)
+
+    def measured(mid: int) -> Optional[BandEdges]:
+        if red:
+            return band_rows(p2d, mid - half, mid + half, True, mid + into_white, mid - beyond, p, column_sigma)
+        return band_rows(p2d, mid - half, mid + half, False, mid - into_white, mid + beyond, p, column_sigma)
+
+    band = measured(lo + (first + last) // 2)
+    # a run much longer than a band that ends merged may hold a background of the band's hue beyond its outer
+    # edge (behind a backlit, dark band it can reach half the band's level): the run's centre then sits off
+    # the band, its level is read half on that background and its inner edge a row into the white body.
+    # The band's own rows are then the band's height of the run next to the body
+    if band is not None and band.merged and last - first + 1 > hb + RUN_SLACK_PX:
+        size = int(hb + 0.5)
+        anchored = measured(lo + ((2 * last - size + 1) if red else (2 * first + size - 1)) // 2)
+        band = anchored if anchored is not None else band
+    return band
