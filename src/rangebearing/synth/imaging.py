@@ -6,6 +6,8 @@ from typing import List, Optional, Tuple
 
 from .._compat import frozen
 
+TONES = ("gamma", "srgb", "filmic")
+
 
 @frozen
 class Imaging:
@@ -33,6 +35,16 @@ class Imaging:
     resolution; ``jpeg_quality`` > 0 passes the frame through JPEG.
     ``exposure_s`` > 0: moving landmarks (``LandmarkPose.velocity_mps``) blur
     over that exposure time (see :func:`.render.render`).
+
+    Another camera's choices (:mod:`.photoreal_alt`, all off by default):
+    ``tone`` is the curve from linear light to 8 bits: ``"gamma"`` (``gamma``
+    alone), ``"srgb"`` (the piecewise sRGB curve) or ``"filmic"`` (an ACES-like
+    shoulder, then sRGB); ``pan_blur_px`` blurs the whole frame horizontally
+    over that many pixels (the observing robot turning during the exposure);
+    ``barrel_k1`` warps the image radially by ``1 + k1·r²`` (normalised
+    coordinates) that the detector's camera does not know of (a calibration's
+    residual); ``h264_quality`` > 0 keeps colour in 2×2 blocks (4:2:0 without
+    interpolation) and passes the frame through a coarse block coder at that quality.
     """
 
     blur_sigma_px: float = 0.0
@@ -59,13 +71,18 @@ class Imaging:
     chroma_420: bool = False
     jpeg_quality: int = 0
     exposure_s: float = 0.0
+    tone: str = "gamma"
+    pan_blur_px: float = 0.0
+    barrel_k1: float = 0.0
+    h264_quality: int = 0
 
     @property
     def isp(self) -> bool:
         """Whether any lens or ISP stage of :mod:`.optics` / :mod:`.isp` is on."""
         return (self.focus_m > 0 or self.soft_corners_px > 0 or self.lateral_colour != 0
                 or self.ccm is not None or self.awb_pull > 0 or self.demosaic != "ea"
-                or self.chroma_denoise_px > 0 or self.sharpen > 0 or self.chroma_420 or self.jpeg_quality > 0)
+                or self.chroma_denoise_px > 0 or self.sharpen > 0 or self.chroma_420 or self.jpeg_quality > 0
+                or self.pan_blur_px > 0 or self.barrel_k1 != 0 or self.h264_quality > 0)
 
 
 def imaging_problems(im: Imaging) -> List[str]:
@@ -77,6 +94,12 @@ def imaging_problems(im: Imaging) -> List[str]:
         out.append(f"imaging.jpeg_quality must be 0-100, got {im.jpeg_quality}")
     if im.focus_m < 0 or im.aperture_m < 0:
         out.append("imaging.focus_m and aperture_m must be >= 0")
+    if im.tone not in TONES:
+        out.append(f"imaging.tone must be one of {', '.join(TONES)}, got {im.tone!r}")
+    if not 0 <= im.h264_quality <= 100:
+        out.append(f"imaging.h264_quality must be 0-100, got {im.h264_quality}")
+    if im.pan_blur_px < 0 or abs(im.barrel_k1) > 0.5:
+        out.append("imaging.pan_blur_px must be >= 0 and |barrel_k1| <= 0.5")
     if im.ccm is not None and len(im.ccm) != 9:
         out.append(f"imaging.ccm must hold 9 numbers, got {len(im.ccm)}")
     return out

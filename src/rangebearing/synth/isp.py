@@ -105,14 +105,42 @@ def chroma_denoise(bgr8: np.ndarray, sigma_px: float) -> np.ndarray:
     return cv2.cvtColor(ycc, cv2.COLOR_YCrCb2BGR)
 
 
-def subsample_chroma(bgr8: np.ndarray) -> np.ndarray:
-    """YCbCr 4:2:0 and back: chroma averaged over 2×2 pixels, then interpolated."""
+def subsample_chroma(bgr8: np.ndarray, blocks: bool = False) -> np.ndarray:
+    """YCbCr 4:2:0 and back: chroma averaged over 2×2 pixels, then interpolated
+    (``blocks``: repeated, as a decoder without chroma interpolation shows it)."""
     ycc = cv2.cvtColor(bgr8, cv2.COLOR_BGR2YCrCb)
     h, w = ycc.shape[:2]
+    up = cv2.INTER_NEAREST if blocks else cv2.INTER_LINEAR
     for ch in (1, 2):
         small = cv2.resize(ycc[..., ch], ((w + 1) // 2, (h + 1) // 2), interpolation=cv2.INTER_AREA)
-        ycc[..., ch] = cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
+        ycc[..., ch] = cv2.resize(small, (w, h), interpolation=up)
     return cv2.cvtColor(ycc, cv2.COLOR_YCrCb2BGR)
+
+
+def h264(bgr8: np.ndarray, quality: int) -> np.ndarray:
+    """A video encoder's frame, roughly: colour in 2×2 blocks (4:2:0, not interpolated), then
+    8×8 block transform coding at ``quality`` (JPEG's quantiser: blocking and ringing)."""
+    return jpeg(subsample_chroma(bgr8, blocks=True), quality)
+
+
+@functools.lru_cache(maxsize=4)
+def tone_lut(tone: str) -> np.ndarray:
+    """uint8 table over 16-bit linear codes (0–65535) for a tone curve other than a plain gamma.
+
+    ``"srgb"``: IEC 61966-2-1's piecewise curve (linear toe below 0.0031308).
+    ``"filmic"``: sRGB followed by an S-shaped contrast curve ``y + 4c·y(1−y)(y−½)``
+    with c = 0.35 (darker shadows, brighter highlights, mid-grey kept; slope 1 − 2c at
+    black and white), as a camera's "contrast" or filmic look does.
+    """
+    x = np.arange(65536, dtype=np.float64) / 65535.0
+    y = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+    if tone == "filmic":
+        y = y + 4.0 * 0.35 * y * (1.0 - y) * (y - 0.5)
+    elif tone != "srgb":
+        raise ValueError(f"unknown tone curve {tone!r}")
+    out = np.round(255.0 * np.clip(y, 0.0, 1.0)).astype(np.uint8)
+    out.setflags(write=False)
+    return out
 
 
 def jpeg(bgr8: np.ndarray, quality: int) -> np.ndarray:

@@ -170,3 +170,40 @@ def lateral_colour(img: np.ndarray, amount: float) -> np.ndarray:
         my = (cy + (yy - cy) / s).astype(np.float32)
         out[..., ch] = cv2.remap(img[..., ch], mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
     return out
+
+
+def box_kernel(length_px: float) -> np.ndarray:
+    """A centred 1-D box ``length_px`` long (fractional ends weighted by their overlap), summing to 1."""
+    half = length_px / 2.0
+    n = 2 * math.ceil(half + 0.5) + 1
+    x = np.arange(n, dtype=np.float64) - n // 2
+    k = np.clip(np.minimum(x + 0.5, half) - np.maximum(x - 0.5, -half), 0.0, None)
+    return (k / k.sum()).astype(np.float32)
+
+
+def pan_blur(img: np.ndarray, length_px: float) -> np.ndarray:
+    """The whole frame smeared horizontally over ``length_px`` (the camera turning at a constant
+    rate during the exposure; symmetric about the exposure's middle, so nothing moves)."""
+    if length_px <= 0.5:
+        return img
+    k = box_kernel(length_px).reshape(1, -1)
+    return cv2.filter2D(img, -1, k, borderType=cv2.BORDER_REFLECT)
+
+
+def barrel(img: np.ndarray, k1: float, fx_px: float, fy_px: float, cx_px: float, cy_px: float) -> np.ndarray:
+    """The image seen through a lens with radial distortion ``1 + k1·r²`` (r in normalised
+    coordinates about the principal point; k1 < 0 is barrel): a point the pinhole puts at
+    ``x`` appears at ``x·(1 + k1·r²)``."""
+    if k1 == 0.0:
+        return img
+    h, w = img.shape[:2]
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64)
+    xn, yn = (xx - cx_px) / fx_px, (yy - cy_px) / fy_px
+    # the undistorted point behind each output pixel (fixed-point steps converge fast for |k1·r²| << 1)
+    xu, yu = xn.copy(), yn.copy()
+    for _ in range(3):
+        s = 1.0 + k1 * (xu * xu + yu * yu)
+        xu, yu = xn / s, yn / s
+    mx = (cx_px + xu * fx_px).astype(np.float32)
+    my = (cy_px + yu * fy_px).astype(np.float32)
+    return cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)

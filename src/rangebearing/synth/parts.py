@@ -86,7 +86,8 @@ def build(scene: Scene) -> Tuple[List[Primitive], List[int]]:
         else:
             out.extend(_robot(lm, lm.body, b + g.height_m / 2, ident()))
         bounds = np.array([b, b + g.band_height_m, b + g.height_m - g.band_height_m])
-        colours = np.array([BLUE_PAINT, WHITE_PAINT, RED_PAINT])
+        red, white, blue = scene.paint or (RED_PAINT, WHITE_PAINT, BLUE_PAINT)
+        colours = np.array([blue, white, red])
         where.append(len(out))
         out.append(Cyl(lm.x_m, lm.z_m, g.radius_m, b, b + g.height_m, bounds, colours,
                        np.array(CAP_GREY), ident(), glossy=True))

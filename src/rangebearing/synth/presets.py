@@ -23,7 +23,8 @@ an auto-exposed Bayer camera:
                ``robot_id`` (see :mod:`.motion`).
 
 The photoreal presets (:mod:`.photoreal`) put those scenes through the Pi
-Camera v1's lens and ISP and richer rooms: ``photoreal``, ``photoreal-crowd``.
+Camera v1's lens and ISP and richer rooms: ``photoreal``, ``photoreal-crowd``;
+``photoreal-alt`` (:mod:`.photoreal_alt`) through another camera and other paint.
 """
 
 from __future__ import annotations
@@ -44,12 +45,13 @@ from .clutter import clutter_scene
 from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene, rooms_scene
 from .motion import crowd_sequence
 from .photoreal import PHOTOREAL_HELP, PHOTOREAL_PRESETS, photoreal_scene, photoreal_sequence
+from .photoreal_alt import ALT_HELP, ALT_PRESET, alt_scene
 from .scene import DEFAULT_CAMERA, LandmarkPose, Scene
 from .touching import touching_scene
 
 ORIGINAL_PRESETS = ("paper", "wide", "clutter", "multi", "sample")
 CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving", "rooms")
-PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS
+PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS + (ALT_PRESET,)
 SAMPLE_FPS = 30.0
 PRESET_HELP = {
     "paper": "one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg",
@@ -67,6 +69,7 @@ PRESET_HELP = {
     "crowd-moving": "4-6 robots driving about and crossing each other at 30 fps; truth.csv's "
                     "robot column keeps each robot's identity",
     **PHOTOREAL_HELP,
+    **ALT_HELP,
 }
 
 
@@ -209,6 +212,8 @@ def random_scene(rng: np.random.Generator, preset: str,
         return next(crowd_sequence(rng, 1, camera))
     if preset in PHOTOREAL_PRESETS:
         return photoreal_scene(rng, preset, camera)
+    if preset == ALT_PRESET:
+        return alt_scene(rng, camera)
     raise SceneError([f"unknown preset {preset!r} (known: {', '.join(PRESETS)})"], "synth")
 
 

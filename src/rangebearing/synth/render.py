@@ -26,6 +26,7 @@ from typing import List, Optional, Tuple
 import cv2
 import numpy as np
 
+from . import isp
 from .camera import Rect, cylinder_bbox_px, pixel_rect, ray_grid
 from .scene import Scene
 from .sensor import develop_sensor
@@ -176,6 +177,11 @@ def _gamma_lut(gamma: float) -> np.ndarray:
     return np.round(255.0 * x**gamma).astype(np.uint8)
 
 
+def _tone_lut(gamma: float, tone: str) -> np.ndarray:
+    """16-bit linear code → 8 bits through the camera's tone curve (``Imaging.tone``)."""
+    return _gamma_lut(gamma) if tone == "gamma" else isp.tone_lut(tone)
+
+
 def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator],
             depth_m: Optional[np.ndarray] = None) -> np.ndarray:
     """Linear radiance to what the camera delivers: BGR uint8 (H, W, 3).
@@ -187,7 +193,7 @@ def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator]
     """
     im, li = scene.imaging, scene.lighting
     if im.auto_exposure or im.bayer or im.glare > 0 or im.vignetting > 0 or im.isp:
-        return develop_sensor(linear, scene, rng, _gamma_lut(float(im.gamma)), depth_m)
+        return develop_sensor(linear, scene, rng, _tone_lut(float(im.gamma), im.tone), depth_m)
     img = linear.astype(np.float32)
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
@@ -198,7 +204,7 @@ def develop(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Generator]
         img += sigma * rng.standard_normal(img.shape, dtype=np.float32)
     np.clip(img, 0.0, 1.0, out=img)
     idx = (img * 65535.0 + 0.5).astype(np.uint16)
-    rgb = np.take(_gamma_lut(float(im.gamma)), idx)
+    rgb = np.take(_tone_lut(float(im.gamma), im.tone), idx)
     return cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
 
 

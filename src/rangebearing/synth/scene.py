@@ -222,7 +222,8 @@ class Scene:
     in bricks (:func:`.surfaces.brick_gain`). ``floor_shading`` (under any
     light but the plain one): the floor gets soft shadows and ambient occlusion from what stands on it (:mod:`.ground`);
     ``local_bounce``: landmarks get light bounced off their robot's board and
-    the objects right beside them (:mod:`.bounce`).
+    the objects right beside them (:mod:`.bounce`). ``paint``: the landmarks' (red,
+    white, blue) paint instead of :data:`RED_PAINT`, :data:`WHITE_PAINT`, :data:`BLUE_PAINT`.
 
     Examples
     --------
@@ -250,6 +251,7 @@ class Scene:
     brick_wall: bool = False
     floor_shading: bool = False
     local_bounce: bool = False
+    paint: Optional[Tuple[RGB, RGB, RGB]] = None
     lighting: Lighting = Lighting()
     imaging: Imaging = Imaging()
 

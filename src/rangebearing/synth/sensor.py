@@ -89,6 +89,9 @@ def develop_sensor(linear: np.ndarray, scene: Scene, rng: Optional[np.random.Gen
     if im.blur_sigma_px > 0.05:
         img = cv2.GaussianBlur(img, (0, 0), im.blur_sigma_px, borderType=cv2.BORDER_REFLECT)
     if im.isp:
+        cam = scene.camera
+        img = optics.barrel(optics.pan_blur(img, im.pan_blur_px), im.barrel_k1, cam.fx_px, cam.fy_px,
+                            cam.cx_px, cam.cy_px)
         img = optics.lateral_colour(optics.soft_corners(img, im.soft_corners_px), im.lateral_colour)
     if im.vignetting > 0:
         img *= _vignette(*img.shape[:2], float(im.vignetting))[..., None]
@@ -129,6 +132,8 @@ def _isp(rgb: np.ndarray, scene: Scene, lut: np.ndarray) -> np.ndarray:
     out = np.take(lut, (rgb * 65535.0 + 0.5).astype(np.uint16))
     out = isp.chroma_denoise(cv2.cvtColor(out, cv2.COLOR_RGB2BGR), im.chroma_denoise_px)
     out = cv2.cvtColor(isp.sharpen(cv2.cvtColor(out, cv2.COLOR_BGR2RGB), im.sharpen), cv2.COLOR_RGB2BGR)
+    if im.h264_quality > 0:
+        return isp.h264(out, im.h264_quality)
     if im.chroma_420 and im.jpeg_quality <= 0:
         out = isp.subsample_chroma(out)
     return isp.jpeg(out, im.jpeg_quality) if im.jpeg_quality > 0 else out
