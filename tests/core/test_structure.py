@@ -4,7 +4,15 @@ import numpy as np
 import pytest
 
 from rangebearing.core.color import to_hsv
-from rangebearing.core.structure import MAX_REGIONS, candidates, column_edges, region_pairs, region_stats, runs
+from rangebearing.core.structure import (
+    MAX_REGIONS,
+    band_regions,
+    candidates,
+    column_edges,
+    region_pairs,
+    region_stats,
+    runs,
+)
 from rangebearing.core.types import LandmarkGeometry
 
 RED, BLUE, WHITE, GREY = (40, 40, 200), (200, 60, 30), (220, 220, 220), (120, 120, 120)
@@ -123,6 +131,25 @@ def test_the_search_is_bounded_by_max_landmarks_and_the_region_cap():
     reds = region_stats(specks, 1)
     assert len(reds) == MAX_REGIONS and reds[:, 5].max() == 12  # the largest regions, that one included
     assert len(region_pairs(reds, reds, 10)) <= 10
+
+
+def test_the_region_cap_keeps_a_far_band_with_blue_below_before_bigger_floor_blotches():
+    # a floor laced with red (more red regions than the cap, each bigger than a far band) and
+    # one far landmark: its small red band has blue under it, the blotches do not
+    img = np.full((240, 320, 3), GREY, np.uint8)
+    for i in range(12):
+        for j in range(16):
+            img[120 + 10 * i : 124 + 10 * i, 4 + 20 * j : 12 + 20 * j] = RED  # 4 x 8 blotches
+    landmark(img, 150, 40, 3, 5)  # 3 x 5 bands: a landmark about 2 m away at half resolution
+    hsv = to_hsv(img)
+    red = ((hsv[..., 0] < 10) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+    blue = ((hsv[..., 0] > 98) & (hsv[..., 0] < 132) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
+    assert len(region_stats(red, 2, cap=False)) > MAX_REGIONS
+    assert not any(r[1] == 150 for r in region_stats(red, 2))  # by area alone the band is dropped
+    reds, blues = band_regions(red, blue, 2)
+    assert len(blues) == 1
+    assert len(reds) == MAX_REGIONS and any(r[1] == 150 and r[2] == 40 for r in reds)
+    assert [c.red_bbox_px[0] for c in candidates(red, blue, hsv, 1, GEOMETRY, 4)] == [150]
 
 
 def test_a_band_merged_with_a_red_thing_reaching_below_the_landmark_is_still_paired():

@@ -71,9 +71,10 @@ class Candidate:
     body_cols_px: Optional[Tuple[int, int]] = None  # [x0, x1) where the white body shows, when only part of it does
 
 
-def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
+def region_stats(mask: np.ndarray, min_area: int, cap: bool = True) -> np.ndarray:
     """``(0, x, y, w, h, box area)`` rows of the external regions of a 0/255 mask whose box holds at
-    least ``min_area`` pixels, the ``MAX_REGIONS`` largest (contours: far cheaper than labelling)."""
+    least ``min_area`` pixels, the ``MAX_REGIONS`` largest (all of them with ``cap=False``;
+    contours: far cheaper than labelling)."""
     contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
     if not contours:
         return np.zeros((0, 6), np.int64)
@@ -81,10 +82,63 @@ def region_stats(mask: np.ndarray, min_area: int) -> np.ndarray:
     area = st[:, 2] * st[:, 3]
     keep = area >= min_area
     st, area = st[keep], area[keep]
-    if len(st) > MAX_REGIONS:
+    if cap and len(st) > MAX_REGIONS:
         top = np.argsort(-area, kind="stable")[:MAX_REGIONS]
         st, area = st[top], area[top]
     return np.column_stack((np.zeros(len(st), np.int64), st, area))
+
+
+def band_regions(red: np.ndarray, blue: np.ndarray, min_area: int) -> Tuple[np.ndarray, np.ndarray]:
+    """The red and the blue :func:`region_stats` of two masks, at most ``MAX_REGIONS`` of each.
+
+    When a colour has more regions than that (a noisy floor or carpet laced with red), the
+    regions with some of the other colour where a partner could be (:func:`partnered`) are
+    kept first, largest first, then the largest of the rest: a far landmark's small band region
+    must not lose its place to big blotches of floor with no blue under them. With both colours
+    under the cap this is :func:`region_stats` of each.
+    """
+    reds, blues = region_stats(red, min_area, cap=False), region_stats(blue, min_area, cap=False)
+    if len(reds) > MAX_REGIONS:
+        reds = _capped(reds, partnered(reds, blue, below=True))
+    if len(blues) > MAX_REGIONS:
+        blues = _capped(blues, partnered(blues, red, below=False))
+    return reds, blues
+
+
+def partnered(regions: np.ndarray, other: np.ndarray, below: bool) -> np.ndarray:
+    """Which regions have a pixel of the ``other`` colour's 0/255 mask where :func:`region_pairs`
+    could find their partner: in their columns, from their top down to a white body's reach
+    (4 widths + 3) below their bottom (``below``: a red region's blue), or up to that far
+    above their top, down to their bottom (a blue region's red). One integral image; a
+    superset of the regions that pair, so none that pairs is put behind one that cannot."""
+    total = cv2.integral(other, sdepth=cv2.CV_32S)
+    h, w = other.shape
+    x0, y0, rw, rh = (regions[:, k] for k in (1, 2, 3, 4))
+    reach = 4 * rw + 3
+    top = y0 if below else y0 - reach - rw
+    bottom = y0 + rh + reach if below else y0 + rh
+    r0, r1 = np.clip(top, 0, h), np.clip(bottom, 0, h)
+    c0, c1 = np.clip(x0, 0, w), np.clip(x0 + rw, 0, w)
+    inside = total[r1, c1] - total[r0, c1] - total[r1, c0] + total[r0, c0]
+    return inside > 0
+
+
+def _capped(st: np.ndarray, first: np.ndarray) -> np.ndarray:
+    return st[np.lexsort((-st[:, 5], ~first))[:MAX_REGIONS]]  # partnered first, then by box area
+
+
+def _pairable(reds: np.ndarray, blues: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(len(reds), len(blues)) arrays: the pairs :func:`region_pairs` examines (band-shaped or
+    merged), the columns each pair shares and whether it is the merged kind."""
+    rx0, ry0, rw, rh = (reds[:, k, None] for k in (1, 2, 3, 4))
+    bx0, by0, bw, bh = (blues[None, :, k] for k in (1, 2, 3, 4))
+    overlap = np.minimum(rx0 + rw, bx0 + bw) - np.maximum(rx0, bx0)
+    gap = by0 - (ry0 + rh)
+    # a white body is 40/35 of the silhouette wide; a partly hidden one (30 % seen) shows less width
+    near = (overlap >= 2) & (gap <= 4 * np.minimum(rw, bw) + 3)
+    shaped = by0 + bh > ry0 + rh
+    merged = ~shaped & (by0 + bh > ry0 + 2)
+    return near & (shaped | merged), overlap, merged
 
 
 def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tuple[int, int]]:
@@ -99,15 +153,8 @@ def region_pairs(reds: np.ndarray, blues: np.ndarray, max_pairs: int) -> List[Tu
     """
     if len(reds) == 0 or len(blues) == 0:
         return []
-    rx0, ry0, rw, rh = (reds[:, k, None] for k in (1, 2, 3, 4))
-    bx0, by0, bw, bh = (blues[None, :, k] for k in (1, 2, 3, 4))
-    overlap = np.minimum(rx0 + rw, bx0 + bw) - np.maximum(rx0, bx0)
-    gap = by0 - (ry0 + rh)
-    # a white body is 40/35 of the silhouette wide; a partly hidden one (30 % seen) shows less width
-    near = (overlap >= 2) & (gap <= 4 * np.minimum(rw, bw) + 3)
-    shaped = by0 + bh > ry0 + rh
-    merged = ~shaped & (by0 + bh > ry0 + 2)
-    i, j = np.nonzero(near & (shaped | merged))
+    ok, overlap, merged = _pairable(reds, blues)
+    i, j = np.nonzero(ok)
     order = np.lexsort((-overlap[i, j], merged[i, j]))[:max_pairs]
     return list(zip(i[order].tolist(), j[order].tolist()))
 
@@ -131,7 +178,7 @@ def search(
 ) -> Found:
     """:func:`candidates` and whether they explain every red and blue region of the masks (:func:`explained`,
     judged only when asked)."""
-    reds, blues = region_stats(red, min_area), region_stats(blue, min_area)
+    reds, blues = band_regions(red, blue, min_area)
     found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks)
     return Found(found, functools.partial(explained, reds, blues, found, scale))
 
@@ -188,13 +235,12 @@ def candidates(
     ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
     pairs per landmark wanted are examined, whatever the frame holds.
     """
-    return _candidates(region_stats(red, min_area), region_stats(blue, min_area), red, blue, hsv, scale, geometry,
-                       max_landmarks)
+    return _candidates(*band_regions(red, blue, min_area), red, blue, hsv, scale, geometry, max_landmarks)
 
 
 def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.ndarray, hsv: np.ndarray, scale: int,
                 geometry: LandmarkGeometry, max_landmarks: int) -> List[Candidate]:
-    """:func:`candidates` from the masks' regions (:func:`region_stats` of ``red`` and ``blue``)."""
+    """:func:`candidates` from the masks' regions (:func:`band_regions` of ``red`` and ``blue``)."""
     white_h = geometry.height_m - 2 * geometry.band_height_m
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
     out: List[Candidate] = []
