@@ -36,6 +36,7 @@ import numpy as np
 
 from .._compat import frozen
 from .association import associate, twins
+from .identity_small import update_small
 from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, measurement_variance, predict
 from .types import Landmark
 
@@ -168,6 +169,7 @@ def update(
     t_s: Optional[float] = None,
     params: Optional[IdentityParams] = None,
     visible: Optional[Sequence[float]] = None,
+    small: bool = True,
 ) -> Tuple[IdentityState, Identified]:
     """Associate one frame's readings with the tracks; returns the new state and each reading's id and rates.
 
@@ -185,6 +187,9 @@ def update(
         Defaults to ``IdentityParams()``.
     visible : sequence of float, optional
         Fraction of each landmark seen (0-1); 1 when not given.
+    small : bool
+        Take :func:`.identity_small.update_small` (floats, not numpy calls) where it
+        applies; ``False`` runs the numpy path always (its reference).
 
     Returns
     -------
@@ -200,11 +205,20 @@ def update(
     sizes), so the common cases take short cuts that give the same result:
     no tracks or no readings skip the association, and when no two gates
     overlap (every gated track has one gated reading and vice versa) the
-    pairs are taken without computing the assignment cost.
+    pairs are taken without computing the assignment cost; up to
+    ``identity_small.MAX_SMALL`` tracks and readings that case runs on floats.
     """
     params = DEFAULT_PARAMS if params is None else params
     m, n = len(range_m), state.size
-    s = predict(state.s, _dt(state, t_s, params), params) if n else state.s
+    dt = _dt(state, t_s, params)
+    if small:  # a few tracks and readings, no two gates overlapping: the same arithmetic on floats
+        done = update_small(state.ids, state.s, state.hidden, state.updates, state.next_id, range_m, bearing_rad,
+                            range_sigma_m, bearing_sigma_rad, dt, params, visible)
+        if done is not None:
+            (ids, s, hidden, updates, next_id), (tid, rr, br) = done
+            return (IdentityState(ids, s, hidden, updates, next_id, t_s),
+                    Identified(track_id=tid, range_rate_mps=rr, bearing_rate_radps=br))
+    s = predict(state.s, dt, params) if n else state.s
     hidden = state.hidden + 1
     updates, ids, next_id = state.updates, state.ids, state.next_id
     det_row = np.full(m, -1, dtype=np.intp)
