@@ -24,7 +24,6 @@ from .._compat import frozen
 from .color import Gains
 from .detect import BandCentroids, combine
 from .frame_edge import near_edge, recut
-from .limbs import cut_sides
 from .measure import Rows, measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
@@ -172,9 +171,7 @@ def step(
     if gone:  # ran off the frame: no reading, as a full scan would give none
         found = [f for k, f in enumerate(found) if k not in gone]
         cands = [c for k, c in enumerate(cands) if k not in gone]
-    w = bgr.shape[1]
-    carry = {k for k, c in enumerate(cands) if c is not None and carries(found[k][0], c, w)}
-    with_cand = [k for k, c in enumerate(cands) if c is not None and k not in carry]
+    with_cand = [k for k, c in enumerate(cands) if c is not None]
     # the edges' noise (sigma_l_px) is not measured again: it is the last full scan's (see _noise)
     rows = measure_rows_all(bgr, [cands[k] for k in with_cand], gains, geometry,
                             [0.5 * (found[k][1].xy_px[0] + found[k][2].xy_px[0]) for k in with_cand], False)
@@ -184,8 +181,6 @@ def step(
     for k, ((t, red, blue), cand) in enumerate(zip(found, cands)):
         if cand is None:
             now: Optional[BandCentroids] = _moved_only(t.bands, _origin(t), red, blue)
-        elif k in carry:
-            now = carried(t, cand, red, blue)
         else:
             now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, _noise(row_of[k], t.bands, cand))
             if now is not None and t.bands.chroma_blur_px is not None:  # the camera's, as the last full scan saw it
@@ -195,36 +190,6 @@ def step(
         kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
         followed.add(id(t))
     return _distinct(kept), [t for t in tracks if id(t) not in followed]
-
-
-def carries(t: Track, cand: Candidate, frame_w_px: int) -> bool:
-    """Whether the track's rows can be carried from its moments (:func:`carried`): a landmark seen whole,
-    no side cut (by the frame's edge or by what stands beside it), no band partly hidden or merged with a
-    background of its colour (its moment then holds some of that background, which the landmark moves over)."""
-    return (t.bands.moments_px is not None and not (cand.hidden_band or cand.red_merged or cand.blue_merged)
-            and cut_sides(cand, frame_w_px) == (False, False))
-
-
-def carried(t: Track, cand: Candidate, red: BandFix, blue: BandFix) -> BandCentroids:
-    """The landmark's bands this frame from their moments alone, each row kept at its last offset from its moment.
-
-    A band's row is the mean of its moment and its edges (:func:`.detect.combine`):
-    the two differ by what the camera does to the band's outline (blur, chroma
-    bleed, a pedestal's shade), which changes as slowly as the landmark's size.
-    A full scan measures that offset and the tracked frames after it keep it,
-    so a tracked frame reads each band once (its moments, :func:`_predicted`)
-    and re-reads no edges. The edges' noise is scaled with the width (:func:`_noise`).
-    """
-    b = t.bands
-    (_, mry), (_, mby) = _origin(t)
-    width_px = 0.5 * (cand.red_bbox_px[2] + cand.blue_bbox_px[2])
-    return BandCentroids(
-        (red.xy_px[0], red.xy_px[1] + b.red_xy_px[1] - mry), (blue.xy_px[0], blue.xy_px[1] + b.blue_xy_px[1] - mby),
-        cand.red_bbox_px, cand.blue_bbox_px, red.mass_px, blue.mass_px, red.chroma_ref, blue.chroma_ref,
-        sigma_l_px=b.sigma_l_px * math.sqrt(b.width_px / max(width_px, 1e-6)), sigma_x_px=b.sigma_x_px,
-        spread_l_px=b.spread_l_px, visible=cand.visible, candidate=cand, moments_px=(red.xy_px, blue.xy_px),
-        chroma_blur_px=b.chroma_blur_px,
-    )
 
 
 def _noise(rows: Optional[Rows], before: BandCentroids, now: Candidate) -> Optional[Rows]:
