@@ -96,6 +96,9 @@ def update_small(
             established = updates[i] >= params.rate_after_updates
             (xr, _, pr, _, _), (xb, _, pb, _, _) = t
             for j, (zr, zb) in enumerate(z):
+                # the outlier noise is the wider (out_r >= r): a pair outside its gate is gated under neither
+                if (zb - xb) ** 2 / (pb + out_r[j][1]) + (zr - xr) ** 2 / (pr + out_r[j][0]) > params.gate_d2:
+                    continue
                 lik = []
                 inside = []
                 for nr, nb in (r[j], out_r[j]):

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from typing import List, Sequence
 
-import numpy as np
-
 from .detect import BandCentroids
 from .tracking import Track, search_boxes
 from .types import XY
@@ -36,8 +34,12 @@ def crossing(tracks: Sequence[Track], slack_px: float = 2.0) -> bool:
         grow = abs(t.velocity_px[0]) + slack_px
         spans.append((min(red[0], blue[0]) - grow, max(red[0] + red[2], blue[0] + blue[2]) + grow))
     spans.sort()
-    ends = np.maximum.accumulate([end for _, end in spans])
-    return any(start < end for (start, _), end in zip(spans[1:], ends[:-1]))
+    reach = spans[0][1]  # the farthest right any landmark so far reaches
+    for start, end in spans[1:]:
+        if start < reach:
+            return True
+        reach = max(reach, end)
+    return False
 
 
 def rescanned(before: Sequence[Track], found: Sequence[BandCentroids], lost: Sequence[Track] = ()) -> List[Track]:
