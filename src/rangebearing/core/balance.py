@@ -182,11 +182,9 @@ def balanced_search(
     band-coloured things no candidate explains, is searched under every balance as before.
     """
     first = find(gains)
-    if isinstance(first, Found):
-        cands = first.candidates
-        done = bool(cands) and first.explained()
-    else:
-        cands, done = first, False
+    cands = first.candidates if isinstance(first, Found) else first
+    # judged only when another balance would be searched (near one it would not)
+    done = isinstance(first, Found) and bool(cands) and not near_unit(gains) and first.explained()
     if not near_unit(gains) and not done:
         cands = merge_candidates(cands, _candidates(find(UNIT_GAINS)), max_landmarks)
     if not near_unit(gains, STRONG_CAST) and not done:
