@@ -109,6 +109,21 @@ def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
     assert drop_stacked([top, smaller_below]) == [top]
 
 
+def test_nothing_farther_shows_inside_a_nearer_landmarks_silhouette():
+    from rangebearing.core.detect import drop_stacked
+
+    near = bands(100, 50, spacing=60.0, w=30)  # rows 45-115, columns 85-115
+    # its red band's top over its body over its own camera board, read as a far landmark
+    inside = bands(100, 48, spacing=24.0, w=8)
+    assert drop_stacked([near, inside]) == [near]
+    # a farther landmark partly hidden beside it shows outside its silhouette: real
+    beside = bands(120, 60, spacing=30.0, w=10)
+    assert drop_stacked([near, beside]) == [near, beside]
+    # one of about its size overlapping it is a touching neighbour, not a part of it
+    neighbour = bands(110, 52, spacing=55.0, w=30)
+    assert drop_stacked([near, neighbour]) == [near, neighbour]
+
+
 def test_under_a_strong_cast_half_the_correction_is_searched_too():
     img, c = frame_with_body((150, 150, 150))
     grey = (0.71, 1.13, 1.35)  # a blue room: grey-world makes the wall grey and the white bodies orange

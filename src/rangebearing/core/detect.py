@@ -221,16 +221,32 @@ def detect_paper(bgr: np.ndarray, cfg: DetectionParams) -> List[BandCentroids]:
 
 STACK_SIZE = 1.25  # a band spacing up to this much larger is still "its size" (measurement scatter)
 STACK_REACH = 2.0  # ... and within this many widths of each other across the image
+NEST_SIZE = 1.25  # a landmark this much nearer (band spacing) hides whatever lies inside its silhouette ...
+NEST_SHARE = 0.5  # ... so a farther one with this share of its box inside that silhouette is part of it
+
+
+def _share_inside(c: BBox, o: BBox) -> float:
+    """The share of box ``c``'s area that lies inside box ``o``."""
+    w = min(c[0] + c[2], o[0] + o[2]) - max(c[0], o[0])
+    h = min(c[1] + c[3], o[1] + o[3]) - max(c[1], o[1])
+    return max(0, w) * max(0, h) / max(1, c[2] * c[3])
 
 
 def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
-    """Drop every landmark that stands wholly below another of its size or larger, nearby in the image.
+    """Drop every landmark that stands wholly below another of its size or larger, nearby in the image,
+    or that lies inside the silhouette of a clearly nearer one.
 
     Landmarks stand on the floor at about the camera's height, so every one
     spans the horizon's row, a nearer one farther above and below it: one
     whose red band lies below the other's blue band is not a landmark but the
     robot under the upper one read as one (its red top plate, a pale bumper, a
     blue floor in front: a red–white–blue column of the right proportions).
+
+    A nearer landmark hides everything behind it, so nothing farther can be
+    seen inside its silhouette (its red top to its blue bottom, its columns):
+    a small "landmark" there is made of the nearer one's own parts (the top
+    of its red band over its body over its robot's camera board in front, read
+    as a far landmark's red, white and blue).
     """
     out = []
     for c in found:
@@ -242,6 +258,12 @@ def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
             and abs(c.red_xy_px[0] - o.red_xy_px[0]) <= STACK_REACH * max(c.width_px, o.width_px)
             for o in found
         )
-        if not below:
+        inside = any(
+            o is not c
+            and NEST_SIZE * l_c <= o.blue_xy_px[1] - o.red_xy_px[1]
+            and _share_inside(c.bbox_px, o.bbox_px) >= NEST_SHARE
+            for o in found
+        )
+        if not (below or inside):
             out.append(c)
     return out

@@ -109,21 +109,32 @@ def _same(a: Optional[List[float]], b: Optional[List[float]]) -> bool:
         abs(math.log((x + 0.01) / (y + 0.01))) <= SAME_COLOUR_LOG for x, y in zip(a, b))
 
 
+def _free(side: Tuple[float, float], boxes: Sequence[Tuple[float, float]]) -> Optional[Tuple[float, float]]:
+    """The widest part of the column span ``side`` that no box's columns cover (``None``: under a third is free)."""
+    cuts = sorted((max(lo, side[0]), min(hi, side[1])) for lo, hi in boxes if lo < side[1] and hi > side[0])
+    best, at = (side[0], side[0]), side[0]
+    for lo, hi in cuts + [(side[1], side[1])]:
+        if lo - at > best[1] - best[0]:
+            best = (at, lo)
+        at = max(at, hi)
+    return best if best[1] - best[0] >= max(1.0, (side[1] - side[0]) / 3) else None
+
+
 def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, float]],
             others: Sequence[BandCentroids] = ()) -> bool:
-    """Whether the colours of ``layers`` (row spans) run on unchanged beyond both sides of ``c``.
+    """Whether the colours of ``layers`` (row spans) run on unchanged beyond the sides of ``c``.
 
-    A side where another candidate's box reaches into the sampled strip does not count as
-    running on (a touching neighbour shows its own bands and body there).
+    Columns where another candidate stands are not looked at (a touching
+    neighbour shows its own bands and body there): a side is judged on what
+    is left of it, and a side that a neighbour covers (two thirds or more)
+    not at all. Stripes run on beyond every side judged, and at least one is.
     """
     x, _, w, _ = c.bbox_px
     near, far = SIDE_REACH[0] * w, SIDE_REACH[1] * w
-    sides = ((x - far, x - near), (x + w + near, x + w + far))
-    for o in others:
-        if o is not c:
-            ox, _, ow, _ = o.bbox_px  # (a property: computed once per other candidate)
-            if any(ox < hi and ox + ow > lo for lo, hi in sides):
-                return False
+    boxes = [(b[0] - 1.0, b[0] + b[2] + 1.0) for b in (o.bbox_px for o in others if o is not c)]  # a property: once
+    sides = [s for s in (_free((x - far, x - near), boxes), _free((x + w + near, x + w + far), boxes)) if s]
+    if not sides:
+        return False
     # body first: beside most real landmarks it is the background, and one differing layer ends the test
     for rows in reversed(layers):
         own = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
