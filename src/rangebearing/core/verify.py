@@ -43,8 +43,10 @@ the checks here ask for:
   a "landmark" there. A landmark is an object: beside it, at the rows of its red
   band and of its white body, lies something else (a background, a wall), not
   both of its own colours again. A candidate whose band and body colours both
-  run on, unchanged, beyond both of its sides (and no other candidate stands
-  there: touching neighbours show their own bands and bodies) is no landmark.
+  run on, unchanged, beyond its sides is no landmark. Columns where another
+  candidate stands are not looked at (touching neighbours show their own bands
+  and bodies), but the rest of that side is: a real landmark right beside a
+  skirting board excuses none of the board.
 
 Levels are taken in linear light over the middle three fifths of the
 candidate's visible columns (limbs darken and mix with the background); of
