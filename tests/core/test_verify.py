@@ -143,7 +143,8 @@ def test_a_neighbour_on_one_side_excuses_only_its_own_columns():
     # a skirting board under a red wall runs on to the left; a real landmark stands on the right: stripes
     assert "stripes" in rejection(striped_frame(), c, GEOMETRY, others=[c, right])
     # a narrow neighbour covers under a third of the right strip: what is left of it is judged
-    sliver = dataclasses.replace(c, red_bbox_px=(X1 + 6, RED_ROWS[0], 4, 15), blue_bbox_px=(X1 + 6, BLUE_ROWS[0], 4, 15))
+    sliver = dataclasses.replace(c, red_bbox_px=(X1 + 6, RED_ROWS[0], 4, 15),
+                                 blue_bbox_px=(X1 + 6, BLUE_ROWS[0], 4, 15))
     beside_grey = striped_frame()
     beside_grey[:, X1 + 2 :] = frame()[:, X1 + 2 :]  # beyond the right side the wall is grey
     assert rejection(beside_grey, c, GEOMETRY, others=[c, sliver]) is None

@@ -115,7 +115,7 @@ def _free(side: Tuple[float, float], boxes: Sequence[Tuple[float, float]]) -> Op
     """The widest part of the column span ``side`` that no box's columns cover (``None``: under a third is free)."""
     cuts = sorted((max(lo, side[0]), min(hi, side[1])) for lo, hi in boxes if lo < side[1] and hi > side[0])
     best, at = (side[0], side[0]), side[0]
-    for lo, hi in cuts + [(side[1], side[1])]:
+    for lo, hi in [*cuts, (side[1], side[1])]:
         if lo - at > best[1] - best[0]:
             best = (at, lo)
         at = max(at, hi)
