@@ -68,12 +68,13 @@ SETS: Tuple[Tuple[str, str, int, bool], ...] = (
     ("photoreal", "png", 1, False),  # not in the default --sets: the Pi camera's lens and ISP (synth docs)
     ("photoreal-crowd", "png", 1, False),
     ("rooms", "png", 1, False),  # lighting frames in an all-red or all-blue room (appended: earlier seeds unchanged)
+    ("photoreal-alt", "png", 1, False),  # photoreal scenes through another camera and paint (appended, as rooms)
 )
 DEFAULT_SETS = tuple(s[0] for s in SETS if not s[0].startswith("photoreal"))
 # issue 8: found share of findable landmarks; paper/wide/clutter/multi keep the core issue's bounds
 MIN_FOUND = {"occlusion": 97.0, "touching": 97.0, "crowd": 97.0, "far": 99.0, "lighting": 97.0,
              "paper": 100.0, "wide": 97.0, "clutter": 100.0, "multi": 97.0,
-             "rooms": 97.0, "photoreal": 97.0, "photoreal-crowd": 97.0}
+             "rooms": 97.0, "photoreal": 97.0, "photoreal-crowd": 97.0, "photoreal-alt": 97.0}
 MAX_FALSE_PER_200 = 1.0
 MAX_RANGE_PCT = (1.0, 3.0)  # mean, p95
 MAX_BEARING_DEG = (0.1, 0.3)
