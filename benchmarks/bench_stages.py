@@ -50,7 +50,7 @@ def stage_breakdown(
     from rangebearing.core.detect import downscale, refine
     from rangebearing.core.model import in_envelope, reading
     from rangebearing.core.refine import Pyramid
-    from rangebearing.core.structure import candidates
+    from rangebearing.core.structure import search
     from rangebearing.core.yuv import WindowHsv, chroma_masks, half_luma, yuv_grey_world_gains
 
     det, geom = cfg.detection, cfg.landmark
@@ -76,7 +76,7 @@ def stage_breakdown(
             laps.lap("class_masks")
             red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
             laps.lap(f"majority_filter ×2 (k={ksize})")
-            cands = candidates(red, blue, hsv, s, geom, det.max_landmarks, min_area)
+            cands = search(red, blue, hsv, s, geom, det.max_landmarks, min_area).candidates
             laps.lap("candidates (regions, pairs, column structure)")
             found_c = refine(frame, cands, det, gains, geom, cam.fy_px, Pyramid(frame, small if s == 2 else None))
             laps.lap("refine (sub-pixel bands, rows from edges)")
@@ -96,7 +96,7 @@ def stage_breakdown(
                 laps.lap("yuv: chroma_masks (table on U, V; Y bounds)")
                 red, blue = majority_filter(red, ksize), majority_filter(blue, ksize)
                 laps.lap(f"yuv: majority_filter ×2 (k={ksize})")
-                candidates(red, blue, WindowHsv(y_half, yuv, gains), 2, geom, det.max_landmarks, min_area)
+                search(red, blue, WindowHsv(y_half, yuv, gains), 2, geom, det.max_landmarks, min_area)
                 laps.lap("yuv: candidates (HSV of the windows only)")
         for k, frame in enumerate(frames):  # passes of their own, so they do not find the frame warm in cache
             laps.start()

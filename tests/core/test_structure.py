@@ -7,12 +7,12 @@ from rangebearing.core.color import to_hsv
 from rangebearing.core.structure import (
     MAX_REGIONS,
     band_regions,
-    candidates,
     column_edges,
     region_pairs,
     region_stats,
     runs,
 )
+from rangebearing.core.structure import search as structure_search
 from rangebearing.core.types import LandmarkGeometry
 
 RED, BLUE, WHITE, GREY = (40, 40, 200), (200, 60, 30), (220, 220, 220), (120, 120, 120)
@@ -70,7 +70,7 @@ def search(img, max_landmarks=16):
     hsv = to_hsv(img)
     red = ((hsv[..., 0] < 10) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
     blue = ((hsv[..., 0] > 98) & (hsv[..., 0] < 132) & (hsv[..., 1] > 90)).astype(np.uint8) * 255
-    return candidates(red, blue, hsv, 1, GEOMETRY, max_landmarks)
+    return structure_search(red, blue, hsv, 1, GEOMETRY, max_landmarks).candidates
 
 
 def test_one_landmark_is_one_whole_candidate():
@@ -149,7 +149,7 @@ def test_the_region_cap_keeps_a_far_band_with_blue_below_before_bigger_floor_blo
     reds, blues = band_regions(red, blue, 2)
     assert len(blues) == 1
     assert len(reds) == MAX_REGIONS and any(r[1] == 150 and r[2] == 40 for r in reds)
-    assert [c.red_bbox_px[0] for c in candidates(red, blue, hsv, 1, GEOMETRY, 4)] == [150]
+    assert [c.red_bbox_px[0] for c in structure_search(red, blue, hsv, 1, GEOMETRY, 4).candidates] == [150]
 
 
 def test_a_band_merged_with_a_red_thing_reaching_below_the_landmark_is_still_paired():

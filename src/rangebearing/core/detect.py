@@ -95,17 +95,11 @@ WHITE_AGREE = 1.3  # white height measured / found by the structure search (2 px
 WHITE_SLACK_PX = 2.0
 
 
-def find_candidates(
-    small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
-) -> List[Candidate]:
-    """Landmark candidates in a frame downscaled by ``cfg.downscale`` (see :mod:`.structure`)."""
-    return search_candidates(small, cfg, gains, ksize, geometry).candidates
-
-
 def search_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry
 ) -> Found:
-    """:func:`find_candidates` and whether they explain every band-coloured region (:func:`.structure.search`)."""
+    """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
+    band-coloured region (:func:`.structure.search`)."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
     red, blue = band_masks(red, blue, ksize)

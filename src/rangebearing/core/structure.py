@@ -20,7 +20,7 @@ column. So:
    (``visible`` < 1), a much wider one is no landmark.
 
 All coordinates here are in the downscaled masks' pixels until
-:func:`candidates` converts them to full-resolution pixels.
+:func:`search` converts them to full-resolution pixels.
 """
 
 from __future__ import annotations
@@ -119,8 +119,17 @@ def search(
     max_landmarks: int,
     min_area: int = 2,
 ) -> Found:
-    """:func:`candidates` and whether they explain every red and blue region of the masks (:func:`explained`,
-    judged only when asked)."""
+    """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
+
+    Returns at most ``max_landmarks`` candidates in full-resolution pixels,
+    the nearest (tallest white body) first: a structure whose red band shares most
+    of a nearer one's is part of it (edge noise inside its band). The work is bounded: at most
+    ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
+    pairs per landmark wanted are examined, whatever the frame holds.
+
+    With them, ``explained()``: whether they explain every red and blue region of
+    the masks (:func:`explained`, judged only when asked).
+    """
     reds, blues = band_regions(red, blue, min_area)
     found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks)
     return Found(found, functools.partial(explained, reds, blues, found, scale))
@@ -161,29 +170,9 @@ def explained(reds: np.ndarray, blues: np.ndarray, found: Sequence[Candidate], s
     return True
 
 
-def candidates(
-    red: np.ndarray,
-    blue: np.ndarray,
-    hsv: np.ndarray,
-    scale: int,
-    geometry: LandmarkGeometry,
-    max_landmarks: int,
-    min_area: int = 2,
-) -> List[Candidate]:
-    """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
-
-    Returns at most ``max_landmarks`` candidates in full-resolution pixels,
-    the nearest (tallest white body) first: a structure whose red band shares most
-    of a nearer one's is part of it (edge noise inside its band). The work is bounded: at most
-    ``MAX_REGIONS`` regions of each colour and ``MAX_PAIRS_PER_LANDMARK`` region
-    pairs per landmark wanted are examined, whatever the frame holds.
-    """
-    return _candidates(*band_regions(red, blue, min_area), red, blue, hsv, scale, geometry, max_landmarks)
-
-
 def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.ndarray, hsv: np.ndarray, scale: int,
                 geometry: LandmarkGeometry, max_landmarks: int) -> List[Candidate]:
-    """:func:`candidates` from the masks' regions (:func:`band_regions` of ``red`` and ``blue``)."""
+    """:func:`search` from the masks' regions (:func:`band_regions` of ``red`` and ``blue``)."""
     white_h = geometry.height_m - 2 * geometry.band_height_m
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
     out: List[Candidate] = []

@@ -22,7 +22,7 @@ lookup when they are not within 2 % of one.
 from __future__ import annotations
 
 import functools
-from typing import List, Optional, Tuple
+from typing import Optional, Tuple
 
 import cv2
 import numpy as np
@@ -31,7 +31,7 @@ from .._compat import frozen
 from .color import UNIT_GAINS, Gains, grey_world_gains, to_hsv
 from .denoise import band_masks
 from .params import DetectionParams
-from .structure import Candidate, Found, search
+from .structure import Found, search
 from .types import LandmarkGeometry
 
 # Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
@@ -248,23 +248,15 @@ class WindowHsv:
         return out
 
 
-def yuv_find_candidates(
-    yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    y_half: Optional[np.ndarray] = None,
-) -> List[Candidate]:
-    """:func:`~rangebearing.core.detect.find_candidates` with the band search on the YUV420 planes.
-
-    ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
-    full-resolution pixels of the frame the planes belong to.
-    """
-    return yuv_search(yuv, cfg, gains, ksize, geometry, y_half).candidates
-
-
 def yuv_search(
     yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
     y_half: Optional[np.ndarray] = None,
 ) -> Found:
-    """:func:`yuv_find_candidates` and whether they explain every band-coloured region (:func:`.structure.search`)."""
+    """:func:`~rangebearing.core.detect.search_candidates` with the band search on the YUV420 planes.
+
+    ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
+    full-resolution pixels of the frame the planes belong to.
+    """
     y_half = half_luma(yuv.y) if y_half is None else y_half
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     red, blue = band_masks(red, blue, ksize)
