@@ -10,8 +10,11 @@ the package.
 
 from __future__ import annotations
 
+import contextlib
+import os
 import signal
-from typing import Any, Dict
+import threading
+from typing import Any, Callable, Dict, Optional
 
 _noted: Dict[str, bool] = {"stop": False, "reload": False}
 
@@ -34,3 +37,56 @@ def taken_over() -> Dict[str, bool]:
     noted = dict(_noted)
     _noted.update(stop=False, reload=False)
     return noted
+
+
+class Relay:
+    """Signals acted on in a thread of their own, never inside the handler.
+
+    A Python signal handler runs in the main thread between any two bytecodes,
+    also while that thread holds a lock: ``Event.set`` from a handler deadlocks
+    when the signal lands inside the same event's ``clear()`` or ``wait()`` (a
+    SIGHUP storm against the loop's reload flag did exactly that). The handler
+    here only writes the signal's number to a pipe (no lock, no allocation to
+    speak of); a daemon thread reads it and calls the action, where taking a
+    lock is an ordinary wait. One a process (:func:`handle`).
+    """
+
+    def __init__(self) -> None:
+        self._actions: Dict[int, Callable[[], None]] = {}
+        self._r, self._w = os.pipe()
+        os.set_blocking(self._w, False)
+        self._pending: Dict[int, bool] = {}  # a pipe that is full (64 KiB of signals) still loses none
+        threading.Thread(target=self._run, name="signals", daemon=True).start()
+
+    def handle(self, actions: Dict[int, Callable[[], None]]) -> None:
+        self._actions.update(actions)
+        for signum in actions:
+            signal.signal(signum, self._handler)
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        self._pending[signum] = True
+        with contextlib.suppress(OSError):  # full: the thread is behind and will see _pending
+            os.write(self._w, bytes((signum,)))
+
+    def _run(self) -> None:
+        while True:
+            try:
+                data = os.read(self._r, 256)
+            except OSError:
+                return
+            if not data:
+                return
+            for signum in dict.fromkeys(data):  # each signal once a batch, in order
+                if self._pending.pop(signum, False) and signum in self._actions:
+                    self._actions[signum]()
+
+
+_relay: Optional[Relay] = None
+
+
+def handle(actions: Dict[int, Callable[[], None]]) -> None:
+    """Call ``actions[signum]()`` on each signal, from the process's relay thread (installed from the main thread)."""
+    global _relay
+    if _relay is None:
+        _relay = Relay()
+    _relay.handle(actions)

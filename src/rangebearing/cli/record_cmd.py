@@ -13,6 +13,7 @@ from typing import Any, Iterator
 
 import cv2
 
+from .. import _signals
 from ..config import Config, check
 from ..core.guarded import process_or_skip
 from ..core.pipeline import Pipeline
@@ -98,8 +99,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         out = check_output_dir(args.out, "--out", inputs, args.overwrite, create=False)
     stop = threading.Event()
-    signal.signal(signal.SIGINT, lambda *_: stop.set())
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    _signals.handle({signal.SIGINT: stop.set, signal.SIGTERM: stop.set})  # not stop.set in a handler: _signals.Relay
     source = open_source(src_cfg, cfg.camera, sleep=stop.wait)  # a source that fails leaves no --out behind
     try:
         mcap = _Mcap(out, args, cfg) if to_mcap else None

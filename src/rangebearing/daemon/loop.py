@@ -122,9 +122,8 @@ class Daemon(Reloading):
 
     def install_signal_handlers(self) -> None:
         """SIGTERM/SIGINT stop, SIGHUP reloads; signals noted while starting (``_signals``) are honoured."""
-        signal.signal(signal.SIGTERM, lambda *_: self.stop())
-        signal.signal(signal.SIGINT, lambda *_: self.stop())
-        signal.signal(signal.SIGHUP, lambda *_: self.request_reload())
+        # acted on in a thread of their own: a handler that sets an Event can deadlock the loop (_signals.Relay)
+        _signals.handle({signal.SIGTERM: self.stop, signal.SIGINT: self.stop, signal.SIGHUP: self.request_reload})
         early = _signals.taken_over()
         if early["stop"]:
             log.info("SIGTERM arrived while starting: stopping")
