@@ -49,6 +49,10 @@ class CameraError(SourceError):
     """The camera is missing, busy, or stopped delivering frames."""
 
 
+class CameraLibraryError(CameraError):
+    """picamera2 cannot be imported: retrying cannot help; the message says what to install."""
+
+
 class CalibrationError(RangeBearingError, ValueError):
     """The calibration data cannot support a fit."""
 

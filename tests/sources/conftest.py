@@ -9,6 +9,8 @@ import cv2
 import numpy as np
 import pytest
 
+from tests.sources.camera_fakes import alt_picamera2, camera  # noqa: F401  (fixtures: both picamera2 fakes)
+
 
 def solid_bgr(value: int, height: int = 48, width: int = 64) -> np.ndarray:
     """A frame whose every pixel is ``value`` in all channels."""

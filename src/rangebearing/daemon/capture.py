@@ -27,7 +27,7 @@ import threading
 import time
 from typing import Callable, Optional, Union
 
-from ..errors import CameraError, FrameError, SourceError
+from ..errors import CameraError, CameraLibraryError, FrameError, SourceError
 from ..sources.base import Frame, FrameSource
 
 log = logging.getLogger("rangebearing.daemon")
@@ -155,6 +155,8 @@ class CaptureGuard:
                 source = opener(sleep)
             except SourceError as exc:
                 left = deadline - self._clock()
+                if isinstance(exc, CameraLibraryError):  # not installed: no retry brings it
+                    raise
                 if left <= 0:
                     raise CameraGone(f"{exc}; no usable camera within {budget:g} s") from None
                 log.warning("%s; retrying in %.1f s (%.0f s left)", exc, min(delay, left), left)

@@ -33,13 +33,33 @@ class Held:
         self._camera_num = camera_num
 
     def array(self, stream: str) -> np.ndarray:
-        """The stream's buffer: in place (kept mapped until :meth:`release`) or copied."""
-        if self._mapped is None:
-            return self.request.make_array(stream)
-        m = self._mapped(self.request, stream, write=False)
-        m.__enter__()
-        self._maps.append(m)
-        return m.array
+        """The stream's buffer: in place (kept mapped until :meth:`release`) or copied.
+
+        A ``MappedArray`` that cannot map (an older signature without ``write``,
+        a stand-in that fails) falls back to ``make_array``; so does every later
+        frame (:attr:`mapped` is then None).
+        """
+        if self._mapped is not None:
+            try:
+                try:
+                    m = self._mapped(self.request, stream, write=False)
+                except TypeError:  # a MappedArray(request, stream) without the write flag
+                    m = self._mapped(self.request, stream)
+                m.__enter__()
+            except Exception as exc:  # any failure to map: copy instead, and say so once
+                _log.warning("camera %d: MappedArray failed (%s): copying frames with make_array",
+                             self._camera_num, exc)
+                self._mapped = None
+            else:
+                self._maps.append(m)
+                if m.array is not None:
+                    return m.array
+        return self.request.make_array(stream)
+
+    @property
+    def mapped(self) -> Any:
+        """``MappedArray`` if it worked for this request (or was not tried yet), else None."""
+        return self._mapped
 
     def release(self) -> None:
         """Unmap every stream and release the request; failures are logged, never raised."""
@@ -55,12 +75,31 @@ class Held:
             _log.warning("camera %d: release failed: %s", self._camera_num, exc)
 
 
+class ArrayRequest:
+    """A request stand-in around one ``capture_array`` result (a picamera2 without ``capture_request``)."""
+
+    def __init__(self, main: np.ndarray) -> None:
+        self._main = main
+
+    def make_array(self, stream: str) -> np.ndarray:
+        if stream != "main":
+            raise KeyError(stream)
+        return self._main
+
+    def get_metadata(self) -> Dict[str, Any]:
+        return {}  # no SensorTimestamp: the frame is stamped when it arrived
+
+    def release(self) -> None:
+        pass
+
+
 # picamera2's byte orders (the manual's "Image formats"; request.py's _make_array_shared gives (H, W, C)):
 # RGB888 is [B, G, R], BGR888 [R, G, B], XBGR8888 [R, G, B, 255], XRGB8888 [B, G, R, 255]
 _TO_BGR = {"RGB888": slice(0, 3), "XRGB8888": slice(0, 3), "BGR888": slice(2, None, -1),
            "XBGR8888": slice(2, None, -1)}
 # the lores stream's Y'CbCr matrix, by libcamera.ColorSpace's ycbcrEncoding and range
 _MATRICES = {("Rec601", "Limited"): "smpte170m", ("Rec709", "Limited"): "rec709", ("Rec601", "Full"): "sycc"}
+_NAMED = {"smpte170m": "smpte170m", "rec709": "rec709", "sycc": "sycc"}  # libcamera ColorSpace::toString()
 
 
 class Layout:
@@ -107,7 +146,12 @@ def granted(active: Dict[str, Any], camera_num: int) -> Layout:
     lores = active.get("lores")
     size, swap, matrix = None, False, "smpte170m"
     if lores:
-        lores_fmt, matrix = str(lores.get("format")), _matrix(active.get("colour_space"))
+        if "colour_space" in active:
+            matrix = _matrix(active["colour_space"])
+        else:  # not reported: picamera2's video default (create_video_configuration), by the main size
+            big = int(main["size"][0]) >= 1280 and int(main["size"][1]) >= 720
+            matrix = "rec709" if big else "smpte170m"
+        lores_fmt = str(lores.get("format"))
         if lores_fmt not in ("YUV420", "YVU420") or matrix is None:
             _log.warning("camera %d: lores stream granted as %s in colour space %s, which the search cannot read: "
                          "searching the main image instead", camera_num, lores_fmt, active.get("colour_space"))
@@ -118,10 +162,19 @@ def granted(active: Dict[str, Any], camera_num: int) -> Layout:
 
 
 def _matrix(colour_space: Any) -> Optional[str]:
-    """Our name for a libcamera.ColorSpace's Y'CbCr matrix and range, or None if it is none we know."""
-    encoding = getattr(getattr(colour_space, "ycbcrEncoding", None), "name", None)
-    full = getattr(getattr(colour_space, "range", None), "name", None)
-    return _MATRICES.get((encoding, full))
+    """Our name for a libcamera.ColorSpace's Y'CbCr matrix and range, or None if it is none we know.
+
+    Read from its ``ycbcrEncoding`` / ``range`` (libcamera enums: their ``name``;
+    plain strings in a stand-in), else from its name (``str()``: "SMPTE170M").
+    """
+    def name(value: Any) -> Any:
+        return value if isinstance(value, str) else getattr(value, "name", None)
+
+    matrix = _MATRICES.get((name(getattr(colour_space, "ycbcrEncoding", None)),
+                            name(getattr(colour_space, "range", None))))
+    if colour_space is None:
+        return None
+    return matrix or _NAMED.get(str(colour_space).lower())
 
 
 def copied(search: Optional[Yuv420]) -> Optional[Yuv420]:

@@ -2,9 +2,29 @@
 
 from __future__ import annotations
 
+import importlib
 from typing import Any, Dict
 
 from ..config import SourceConfig
+from ..errors import CameraError, CameraLibraryError
+
+INSTALL_HINT = "apt install python3-picamera2 and create the venv with --system-site-packages"
+
+
+def optional_module(name: str) -> Any:
+    """The module, or None: picamera2 needs libcamera, but a stand-in picamera2 may come without it."""
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        return None
+
+
+def import_module(name: str) -> Any:
+    """The module, or CameraLibraryError with the install hint."""
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise CameraLibraryError(f"cannot import {name} ({exc}); {INSTALL_HINT}") from None
 
 
 def camera_controls(cfg: SourceConfig) -> Dict[str, Any]:
@@ -38,3 +58,56 @@ def camera_count_text(picamera2_cls: Any) -> str:
         return str(len(picamera2_cls.global_camera_info()))
     except Exception:  # only for the message: never mask the real error
         return "none"
+
+
+def video_configuration(cfg: SourceConfig, libcamera: Any) -> Dict[str, Any]:
+    """Keyword arguments of ``create_video_configuration`` for ``cfg``: main RGB888 (+ lores YUV420).
+
+    ``libcamera`` (the module, or None where it cannot be imported) gives the
+    colour space (SMPTE 170M, set explicitly: picamera2 picks Rec709 from
+    1280×720 up) and the flips. Without it picamera2 picks the colour space
+    and :func:`~.camera_buffers.granted` reads which; flips then cannot be asked
+    for (CameraError).
+    """
+    size = (cfg.width_px, cfg.height_px)  # a tuple: picamera2 refuses a list ("should be (width, height)")
+    kwargs: Dict[str, Any] = {
+        "main": {"format": "RGB888", "size": size},
+        "lores": {"format": "YUV420", "size": size} if cfg.lores else None,
+        "controls": camera_controls(cfg),
+        "buffer_count": cfg.buffer_count,
+    }
+    if libcamera is not None:
+        kwargs["colour_space"] = libcamera.ColorSpace.Smpte170m()
+        kwargs["transform"] = libcamera.Transform(hflip=cfg.hflip, vflip=cfg.vflip)
+    elif cfg.hflip or cfg.vflip:
+        raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need libcamera.Transform, "
+                          "and libcamera cannot be imported")
+    return kwargs
+
+
+def granted_configuration(cam: Any, asked: Dict[str, Any]) -> Dict[str, Any]:
+    """The configuration the camera runs with: ``camera_configuration()``, else per stream, else what was asked.
+
+    Every picamera2 since 0.3 has ``camera_configuration()``; without it the
+    streams come from ``stream_configuration(name)``; without both, the dict
+    passed to ``configure()`` (whose stream dicts the real ``configure`` fills in
+    with the granted size, format and stride: it copies the outer dict only).
+    """
+    try:
+        active = cam.camera_configuration()
+        if isinstance(active, dict) and isinstance(active.get("main"), dict):
+            if "colour_space" not in active and "colour_space" in asked:
+                return {**active, "colour_space": asked["colour_space"]}
+            return active
+    except (AttributeError, TypeError, RuntimeError, KeyError):
+        pass
+    streams: Dict[str, Any] = {}
+    try:
+        for name in ("main", "lores"):
+            if asked.get(name) is not None:
+                streams[name] = cam.stream_configuration(name)
+        if isinstance(streams.get("main"), dict):
+            return {**asked, **streams}
+    except (AttributeError, TypeError, RuntimeError, KeyError):
+        pass
+    return asked

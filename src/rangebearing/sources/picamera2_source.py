@@ -1,47 +1,39 @@
 """The Raspberry Pi camera through Picamera2, with the library's sharp edges handled.
 
 Written against picamera2 (raspberrypi/picamera2: picamera2/picamera2.py,
-request.py, job.py) and the manual "The Picamera2 Library":
+request.py, job.py) and the manual "The Picamera2 Library"; docs/picamera2.md
+lists each behaviour relied on and what happens when a picamera2 lacks it:
 
 * ``Picamera2(n)`` looks ``n`` up in ``global_camera_info()``, so a missing
   camera raises IndexError (after opening a pipe it does not close: the camera
-  count is asked first); a camera held by another process fails in
-  ``acquire()`` and surfaces as RuntimeError("Camera __init__ sequence did not
-  complete.").
+  count is asked first); a busy camera fails in ``acquire()``: RuntimeError.
 * ``capture_request()`` without ``wait=`` blocks forever. With ``wait=t`` the
   job's Future raises ``concurrent.futures.TimeoutError`` (the builtin
   TimeoutError only from Python 3.11) and the job stays queued: it would eat
-  the next frame and leak its request, and ``stop()`` would queue behind it, so
-  ``cancel_all_and_flush()`` must follow a timeout.
-  A false ``wait`` (``0``) would return the Job instead (``dispatch_functions``):
-  the config's ``timeout_s`` is always > 0.
+  the next frame and leak its request, so ``cancel_all_and_flush()`` follows a
+  timeout. A false ``wait`` (``0``) returns the Job instead: ``timeout_s`` > 0.
 * ``"RGB888"`` pixels are stored [B, G, R] (request.py maps RGB888 to PIL mode
-  "BGR"), i.e. already OpenCV order: no channel swap here. ``configure()`` may
-  grant another format, size or colour space than asked (libcamera's
-  ``validate()``: "Adjusted"): the streams are read as ``camera_configuration()``
-  says (:func:`~.camera_buffers.granted`): BGR888/XBGR8888/XRGB8888 reordered,
-  YVU420 lores swapped back, the lores matrix from the granted colour space;
-  a main stream that is not RGB (a USB camera's YUYV, MJPEG) is a CameraError.
-* ``MappedArray`` gives the main stream as (H, W, C) with the rows' stride
-  padding sliced off (``_make_array_shared``), lores YUV420 as (H·3/2, stride)
-  with the padding left in: the planes are cut from it.
+  "BGR"), i.e. already OpenCV order. ``configure()`` may grant another format,
+  size or colour space than asked (libcamera's ``validate()``): the streams are
+  read as granted (:func:`~.camera_buffers.granted`); a main stream that is not
+  RGB (a USB camera's YUYV, MJPEG) is a CameraError.
+* ``MappedArray`` gives the main stream as (H, W, C) with the stride padding
+  sliced off, lores YUV420 as (H·3/2, stride) with the padding left in.
 * Every request must be released or the camera runs out of buffers.
-* ``lores`` (the manual's "lores" stream; YUV420 only on Pi 4 and earlier):
-  requested at the main size, so its U and V planes are at half resolution,
-  the pipeline's search scale. Colour space SMPTE 170M (BT.601 limited range)
-  is set explicitly: picamera2 would pick Rec709 from 1280×720 up.
-* Buffers are read in place with ``MappedArray`` (request.py), not with
-  ``make_array``, which copies the whole frame. With ``in_place=True`` (the
-  daemon) the request is held until the next ``read()`` (or ``close()``), so
-  a frame's arrays are views into camera memory valid until then, and at most
-  one request is held; otherwise the frame is copied out and the request
-  released at once (callers that keep frames, e.g. ``tune``).
+* ``lores`` (YUV420 only on Pi 4 and earlier) is requested at the main size, so
+  its U and V planes are at half resolution, the pipeline's search scale, in
+  SMPTE 170M (set explicitly: picamera2 would pick Rec709 from 1280×720 up).
+* Extras degrade to the core calls: no libcamera (colour space as picamera2
+  picks it), no ``camera_configuration()`` (per stream, else as asked), no
+  ``MappedArray`` (``make_array`` copies), no ``capture_request`` (``capture_array``).
+* With ``in_place=True`` (the daemon) the request is held until the next
+  ``read()`` (or ``close()``): a frame's arrays are views into camera memory
+  valid until then; otherwise the frame is copied out and the request released.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
-import importlib
 import logging
 import threading
 import time
@@ -53,8 +45,16 @@ from ..config import SourceConfig
 from ..core.yuv import Yuv420
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
-from .camera_buffers import Held, Layout, copied, granted
-from .camera_setup import camera_controls, camera_count, camera_count_text
+from .camera_buffers import ArrayRequest, Held, Layout, copied, granted
+from .camera_setup import (
+    camera_controls,
+    camera_count,
+    camera_count_text,
+    granted_configuration,
+    import_module,
+    optional_module,
+    video_configuration,
+)
 from .sensor_time import boot_offset_ns, frames_missed, sensor_to_monotonic_ns
 
 __all__ = ["Picamera2Source", "camera_controls", "frames_missed", "sensor_to_monotonic_ns"]
@@ -62,15 +62,7 @@ from .faults import TimeoutBudget
 
 _log = logging.getLogger(__name__)
 
-INSTALL_HINT = "apt install python3-picamera2 and create the venv with --system-site-packages"
 _TIMEOUTS = (TimeoutError, concurrent.futures.TimeoutError)
-
-
-def _import(name: str) -> Any:
-    try:
-        return importlib.import_module(name)
-    except ImportError as exc:
-        raise CameraError(f"cannot import {name} ({exc}); {INSTALL_HINT}") from None
 
 
 class Picamera2Source:
@@ -137,30 +129,21 @@ class Picamera2Source:
         """Acquire, configure and start the camera; CameraError if it cannot be done."""
         if self._cam is not None:
             return
-        picamera2 = _import("picamera2")
-        libcamera = _import("libcamera")
+        picamera2 = import_module("picamera2")
         cam = self._acquire(picamera2.Picamera2)
         self._mapped = getattr(picamera2, "MappedArray", None)
         cfg = self._cfg
-        size = (cfg.width_px, cfg.height_px)
         try:
-            config = cam.create_video_configuration(
-                main={"format": "RGB888", "size": size},
-                lores={"format": "YUV420", "size": size} if cfg.lores else None,
-                colour_space=libcamera.ColorSpace.Smpte170m(),
-                controls=camera_controls(cfg),
-                transform=libcamera.Transform(hflip=cfg.hflip, vflip=cfg.vflip),
-                buffer_count=cfg.buffer_count,
-            )
+            config = cam.create_video_configuration(**video_configuration(cfg, optional_module("libcamera")))
             cam.configure(config)
             # what libcamera granted (validate() may adjust sizes, formats and the colour space)
-            self._layout = granted(cam.camera_configuration(), cfg.camera_num)
+            self._layout = granted(granted_configuration(cam, config), cfg.camera_num)
             cam.start()
         except CameraError:
             self._cam = cam
             self.close()
             raise
-        except (RuntimeError, ValueError, KeyError, TypeError) as exc:
+        except (RuntimeError, ValueError, KeyError, TypeError, AttributeError) as exc:
             self._cam = cam
             self.close()
             msg = f"camera {cfg.camera_num}: cannot configure and start: {exc}"
@@ -205,7 +188,7 @@ class Picamera2Source:
             raise SourceError("Picamera2 source is not open")
         self._release_held()  # the last frame is done with: its buffers go back to the camera
         try:
-            request = cam.capture_request(wait=self._cfg.timeout_s)
+            request = self._capture(cam)
         except _TIMEOUTS:
             raise self._timed_out(cam) from None
         except (RuntimeError, concurrent.futures.CancelledError) as exc:
@@ -215,11 +198,12 @@ class Picamera2Source:
         layout = self._layout
         try:
             array = held.array("main")
-            lores = held.array("lores") if layout.lores_size else None  # type: ignore[union-attr]
             metadata = request.get_metadata()
         except (RuntimeError, ValueError) as exc:
             self._release_held()
             raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
+        self._mapped = held.mapped
+        lores = self._lores(held) if layout.lores_size else None  # type: ignore[union-attr]
         self._budget.frame_arrived()
         self._metadata = metadata
         image = validate_frame(layout.bgr(array))  # type: ignore[union-attr]  # a view if contiguous, else a copy
@@ -235,9 +219,32 @@ class Picamera2Source:
         if held is not None:
             held.release()
 
+    def _capture(self, cam: Any) -> Any:
+        """The next completed request; a picamera2 without ``capture_request`` gives main arrays only."""
+        capture = getattr(cam, "capture_request", None)
+        if capture is not None:
+            return capture(wait=self._cfg.timeout_s)
+        if self._layout is not None and self._layout.lores_size is not None:
+            _log.warning("camera %d: no capture_request(): main stream only, searched in full",
+                         self._cfg.camera_num)
+            self._layout.lores_size = None
+        return ArrayRequest(cam.capture_array("main", wait=self._cfg.timeout_s))
+
+    def _lores(self, held: Held) -> Optional[np.ndarray]:
+        """The lores buffer, or None from now on if the request cannot give it (the main image is searched)."""
+        try:
+            return held.array("lores")
+        except (RuntimeError, ValueError, KeyError, AttributeError) as exc:
+            _log.warning("camera %d: no lores stream in the request (%s): searching the main image",
+                         self._cfg.camera_num, exc)
+            self._layout.lores_size = None  # type: ignore[union-attr]
+            return None
+
     def _timed_out(self, cam: Any) -> Exception:
-        # The timed-out job is still queued: flush it before it swallows a frame.
-        cam.cancel_all_and_flush()
+        # The timed-out job is still queued: flush it before it swallows a frame (and leaks its request).
+        flush = getattr(cam, "cancel_all_and_flush", None)
+        if flush is not None:
+            flush()
         return self._budget.timed_out()
 
     def _stamp(self, image: np.ndarray, search: Optional[Yuv420], metadata: Dict[str, Any],
@@ -272,7 +279,8 @@ class Picamera2Source:
             # Each step runs even if the one before failed: the camera must be released.
             for step in ("cancel_all_and_flush", "stop", "close"):
                 try:
-                    getattr(cam, step)()
+                    if hasattr(cam, step):  # a stand-in picamera2 may lack cancel_all_and_flush
+                        getattr(cam, step)()
                 except Exception as exc:  # log and go on releasing
                     _log.warning("camera %d: %s() failed: %s", self._cfg.camera_num, step, exc)
             done.set()

@@ -74,6 +74,15 @@ class Rig:
     missing: set = field(default_factory=set)
     acquired: set = field(default_factory=set)  # camera numbers this process holds
     frames_delivered: int = 0
+    instances: list = field(default_factory=list)  # every Picamera2 made since configure()
+    ticks: int = 0  # event-loop rounds run (any camera)
+    tick: threading.Condition = field(default_factory=threading.Condition)
+
+    def wait_ticks(self, rounds: int, timeout_s: float = 10.0) -> bool:
+        """Block until the cameras' event loops ran `rounds` more rounds (a frame in flight has landed)."""
+        with self.tick:
+            goal = self.ticks + rounds
+            return self.tick.wait_for(lambda: self.ticks >= goal, timeout_s)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def frame(self, sequence: int) -> np.ndarray:
@@ -84,6 +93,21 @@ class Rig:
         if callable(scene):
             return np.asarray(scene(sequence), np.uint8)
         return np.asarray(scene[sequence % len(scene)], np.uint8)
+
+
+def held() -> int:
+    """Requests capture_request handed out and not yet released, over every camera of the rig."""
+    count = 0
+    for cam in RIG.instances:
+        with cam.request_lock:
+            count += sum(1 for r in cam._handed if r.request is not None)
+    return count
+
+
+def shutdown() -> None:
+    """Close every camera still open (a test's teardown)."""
+    for cam in RIG.instances:
+        cam.close()
 
 
 RIG = Rig()

@@ -59,6 +59,7 @@ class Picamera2:
         cameras.sort(key=lambda cam: ("/usb" not in cam["Id"], cam["Id"]), reverse=True)
         camera_num = cameras[camera_num]["Num"]
         self.camera_idx = camera_num
+        rigmod.RIG.instances.append(self)
         self.request_lock = threading.Lock()
         self._reset_flags()
         try:
@@ -89,6 +90,7 @@ class Picamera2:
         self._loop: Optional[threading.Thread] = None
         self._closing = False
         self._sequence = 0
+        self._handed: list[CompletedRequest] = []  # what capture_request gave out (picamera2_alt_rig.held)
 
     def _open_camera(self) -> None:
         """Grab and acquire the camera (picamera2.py:524-577): RuntimeError when it is busy."""
@@ -278,7 +280,8 @@ class Picamera2:
                                                                            self.create_preview_configuration)()
         if not isinstance(camera_config, dict):
             raise TypeError("Invalid type for `camera_config` given")
-        config = {k: (dict(v) if isinstance(v, dict) else v) for k, v in camera_config.items()}
+        # picamera2.py:1186: a SHALLOW copy: the caller's stream dicts get the granted stride/size written in
+        config = camera_config.copy()
         if config.get("raw") is not None:
             config["raw"].setdefault("format", self._modes[0][0])
             config["raw"].setdefault("size", config["main"]["size"])
@@ -299,6 +302,7 @@ class Picamera2:
             rows = stream["size"][1] * 3 // 2 if stream["format"] in ("YUV420", "YVU420") else stream["size"][1]
             stream["stride"] = stride
             stream["framesize"] = stride * rows
+        self._colour_space = config.get("colour_space")  # what the ISP encodes with, reported or not
         if "colour_space" in rigmod.RIG.missing:
             config.pop("colour_space", None)
         elif self.camera.usb:
@@ -437,6 +441,9 @@ class Picamera2:
             elif not self.started:
                 next_frame = now + 0.05
             self._process_requests(new)
+            with rigmod.RIG.tick:
+                rigmod.RIG.ticks += 1
+                rigmod.RIG.tick.notify_all()
 
     def _expose(self, now: float, duration_us: int) -> Optional[CompletedRequest]:
         """Complete one frame into a queued request; None if the sensor is silent or no request is queued."""
@@ -452,7 +459,7 @@ class Picamera2:
         scene = rig.frame(self._sequence)
         config = self.camera_config
         for name, buffer in request.buffers.items():
-            _pack(scene, config[name], buffer, config.get("colour_space"))
+            _pack(scene, config[name], buffer, self._colour_space)
         exposure = min(20000, duration_us - 500)
         request.metadata = {
             "SensorTimestamp": int(now * 1e9) - 2_000_000,  # CLOCK_MONOTONIC ns, start of readout (1552-1564)
@@ -527,7 +534,9 @@ class Picamera2:
     def _capture_request(self) -> tuple[bool, Any]:  # picamera2.py:1831-1835
         if not self.completed_requests:
             return (False, None)
-        return (True, self.completed_requests.pop(0))
+        request = self.completed_requests.pop(0)
+        self._handed = [r for r in self._handed if r.request is not None] + [request]  # rig bookkeeping
+        return (True, request)
 
     def capture_request(self, wait: Any = None, signal_function=None, flush: Any = None) -> Any:
         """The next completed request; the caller must release() it (picamera2.py:1855-1865)."""
