@@ -130,8 +130,8 @@ def alt_picamera2(monkeypatch: pytest.MonkeyPatch) -> Iterator[tuple[ModuleType,
     try:
         yield picamera2, picamera2_alt_rig
     finally:
+        picamera2_alt_rig.shutdown()  # every camera of this test closed, its thread ended
         picamera2_alt_rig.configure()  # puts back any extra a test removed
-        picamera2_alt_rig.shutdown()
         for name in _fake_modules():
             if name != "libcamera":
                 sys.modules.pop(name, None)

@@ -280,3 +280,22 @@ def test_no_picamera2_is_one_clear_error(monkeypatch: pytest.MonkeyPatch) -> Non
     with pytest.raises(CameraLibraryError, match=r"cannot import picamera2.*--system-site-packages"):
         Picamera2Source(SourceConfig()).open()
 
+
+
+@pytest.mark.parametrize("main_format", ["RGB888", "BGR888", "XBGR8888", "XRGB8888"])
+@pytest.mark.parametrize("lores_format", ["YUV420", "YVU420"])
+def test_formats_libcamera_may_grant_instead(alt_picamera2: Any, main_format: str, lores_format: str) -> None:
+    module, rig = alt_picamera2
+    rig.configure(frame_duration_us=5000, scene=lambda seq: noise(seq, H, W),
+                  adjust={"main": {"format": main_format}, "lores": {"format": lores_format}})
+    source = open_source(Alt(module, rig))
+    try:
+        frame = source.read()
+        assert rig.RIG.instances[0].camera_configuration()["main"]["format"] == main_format
+        assert frame is not None and frame.image.shape == (H, W, 3) and frame.lores_yuv420 is not None
+        want = yuv420_from_bgr(frame.image)  # BGR in the right order: its YUV matches the camera's
+        for got, ref in ((frame.lores_yuv420.y, want.y), (frame.lores_yuv420.u, want.u),
+                         (frame.lores_yuv420.v, want.v)):
+            assert np.abs(got.astype(int) - ref.astype(int)).max() <= 2
+    finally:
+        source.close()

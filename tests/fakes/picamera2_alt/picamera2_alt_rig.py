@@ -7,6 +7,8 @@ module is how a test sets up what the camera sees and how it fails:
 - `configure(cameras=..., platform=..., scene=..., frame_duration_us=..., stop_after=..., busy=..., missing=...)`
   in process, or the environment variable PICAMERA2_ALT_RIG naming a JSON file with the same keys (read when the
   package is imported: a `rangebearing run` subprocess); `scene` is then a path to an .npy file (N, H, W, 3) RGB.
+- `adjust`: {"main": {"format": "XBGR8888"}, "lores": {"format": "YVU420"}}: what libcamera's validate() grants
+  instead of what was asked (picamera2.py:1207-1214 logs "Camera configuration has been adjusted!").
 - `missing`: API extras a less complete fake might not have (`global_camera_info`, `camera_configuration`,
   `stream_configuration`, `MappedArray`, `align_configuration`, `camera_properties`, `sensor_modes`, `platform`,
   `cancel_all_and_flush`, `colour_space`): removed from the package when it is configured.
@@ -72,6 +74,7 @@ class Rig:
     stop_after: Optional[int] = None  # frames delivered, then the sensor goes silent (cable pulled)
     busy: set = field(default_factory=set)  # camera numbers another process holds
     missing: set = field(default_factory=set)
+    adjust: dict = field(default_factory=dict)  # stream -> fields libcamera's validate() changes ("Adjusted")
     acquired: set = field(default_factory=set)  # camera numbers this process holds
     frames_delivered: int = 0
     instances: list = field(default_factory=list)  # every Picamera2 made since configure()
@@ -104,13 +107,20 @@ def held() -> int:
     return count
 
 
+def register(cam: Any) -> None:
+    """A new Picamera2 (called by its constructor)."""
+    RIG.instances.append(cam)
+    _EVERY.append(cam)
+
+
 def shutdown() -> None:
-    """Close every camera still open (a test's teardown)."""
-    for cam in RIG.instances:
-        cam.close()
+    """Close every camera made in this process that is still open (a test's teardown), across configure()s."""
+    while _EVERY:
+        _EVERY.pop().close()
 
 
 RIG = Rig()
+_EVERY: list = []
 _REMOVED: dict[tuple[Any, str], Any] = {}
 
 

@@ -59,7 +59,7 @@ class Picamera2:
         cameras.sort(key=lambda cam: ("/usb" not in cam["Id"], cam["Id"]), reverse=True)
         camera_num = cameras[camera_num]["Num"]
         self.camera_idx = camera_num
-        rigmod.RIG.instances.append(self)
+        rigmod.register(self)
         self.request_lock = threading.Lock()
         self._reset_flags()
         try:
@@ -293,6 +293,7 @@ class Picamera2:
             stream = config[name]
             if stream is None:
                 continue
+            stream.update(rigmod.RIG.adjust.get(name, {}))  # validate() -> Adjusted (picamera2.py:1207-1214)
             if name == "raw":
                 stream["size"] = tuple(stream["size"])
                 stream["stride"] = stream["size"][0] * 2
