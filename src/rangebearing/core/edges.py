@@ -99,6 +99,7 @@ class BandEdges:
     inner: float
     merged: bool
     sigma: float  # one-sigma uncertainty of ``centre`` from the column-to-column scatter
+    scatter: Optional[Tuple[float, float, int, int]] = None  # what measures ``sigma``: level, bg, mid, end rows
 
 
 def band_rows(
@@ -137,7 +138,7 @@ def band_rows(
         outer = inner if merged else edge_down(p, mid + 1, outer_end, level, o_bg)
     centre = 0.5 * (inner + outer)
     sigma = _column_sigma(p2d, level, w_bg, mid, white_end, inner_down) if column_sigma else float("nan")
-    return BandEdges(centre, inner, merged, sigma)
+    return BandEdges(centre, inner, merged, sigma, (level, w_bg, mid, white_end))
 
 
 def step_floor(level: float) -> float:

@@ -24,6 +24,7 @@ import numpy as np
 from .._compat import frozen
 from .band_seed import seeded_band as _band
 from .color import Gains
+from .column_scatter import Scatter, column_sigmas
 from .edges import BandEdges, excess_luma, luma_edge, mean_along
 from .limbs import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, outline_centre, thin_step
 from .structure import Candidate
@@ -161,22 +162,32 @@ def measure_rows_all(
     eb_all *= wst
     lu_all *= wst
     out: List[Optional[Rows]] = []
+    later: List[tuple] = []  # the bands' column scatter, measured for all bands at once (core/column_scatter.py)
     j = 0
     for c, win in zip(cands, wins):
         if win is None:
             out.append(None)
             continue
         o, n, m = offs[j], tiles[j].shape[0], tiles[j].shape[1]
+        got = len(later)
         out.append(_rows(c, geometry, win[1], er_all[o : o + n, :m], eb_all[o : o + n, :m], column_sigma,
-                         lu_all[o : o + n, :m]))
+                         lu_all[o : o + n, :m], later if column_sigma else None))
+        if len(later) > got:
+            later[-1] += (len(out) - 1, o, n, m)
         j += 1
+    specs: List[Scatter] = [(b, o, n, m, *bands[b], b == 0) for *bands, _, _, o, n, m in later for b in (0, 1)]
+    sigmas = column_sigmas((er_all, eb_all), specs)
+    for (_, _, factor, k, *_), s_red, s_blue in zip(later, sigmas[0::2], sigmas[1::2]):
+        out[k] = dataclasses.replace(out[k], sigma_l_px=math.hypot(s_red, s_blue) * factor)
     return out
 
 
 def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb: np.ndarray,
-          column_sigma: bool = True, lu: Optional[np.ndarray] = None) -> Optional[Rows]:
+          column_sigma: bool = True, lu: Optional[np.ndarray] = None, later: Optional[list] = None) -> Optional[Rows]:
     """A candidate's :class:`Rows` from its weighted excess tiles and luma tile ``lu``
-    (``oy``: the tiles' first frame row)."""
+    (``oy``: the tiles' first frame row). ``later``: a list the bands' scatter and the sigma's factor go to,
+    ``sigma_l_px`` then NaN (the caller measures all bands' column scatter at once)."""
+    column_sigma = column_sigma and later is None
     white_m = geometry.height_m - 2 * geometry.band_height_m
     band_px = c.white_px * geometry.band_height_m / white_m
     f = 1
@@ -203,7 +214,9 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
             red, blue, white = l_red, l_blue, l_white
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
-    sigma = float(np.hypot(red.sigma, blue.sigma)) * (1.0 + (2 * k if red.merged or blue.merged else 0.0))
+    factor = 1.0 + (2 * k if red.merged or blue.merged else 0.0)
+    sigma = float(np.hypot(red.sigma, blue.sigma)) * factor
+    later is None or later.append((red.scatter, blue.scatter, factor))
     return Rows(
         oy + (red_y + 0.5) * f - 0.5,
         oy + (blue_y + 0.5) * f - 0.5,
