@@ -5,7 +5,7 @@ Usage::
     # the old tree (any checkout) and this one, on the same sets and config
     PYTHONPATH=<old checkout>/src python benchmarks/same_readings.py dump old.pkl --config cal.yaml SET_DIR...
     python benchmarks/same_readings.py dump new.pkl --config cal.yaml SET_DIR...
-    python benchmarks/same_readings.py compare old.pkl new.pkl [--rel 1e-9]
+    python benchmarks/same_readings.py compare old.pkl new.pkl [--rel 1e-9] [--loose range_sigma_m=1e-5]
 
 ``dump`` replays each set directory (``rangebearing synth`` output: numbered PNG or
 JPEG frames) through ``Pipeline.process`` as full scans of independent frames; a
@@ -70,7 +70,28 @@ def _close(x: object, y: object, rel: float) -> bool:
     return x == y
 
 
-def compare(a_path: str, b_path: str, rel: float) -> int:
+def _close_reading(x: tuple, y: tuple, rel: float, loose: dict) -> bool:
+    """Two readings (Landmark fields in order) alike; a field index in ``loose`` within its own tolerance."""
+    return len(x) == len(y) and all(_close(p, q, loose.get(k, rel)) for k, (p, q) in enumerate(zip(x, y)))
+
+
+def _close_frame(fa: tuple, fb: tuple, rel: float, loose: dict) -> bool:
+    if not loose:
+        return _close(fa, fb, rel)
+    return fa[0] == fb[0] and len(fa[1]) == len(fb[1]) and all(
+        _close_reading(x, y, rel, loose) for x, y in zip(fa[1], fb[1]))
+
+
+def compare(a_path: str, b_path: str, rel: float, loose: dict | None = None) -> int:
+    """``loose``: Landmark field name → its own relative tolerance (the others bit for bit or ``rel``)."""
+    from rangebearing import Landmark
+
+    names = list(Landmark.__dataclass_fields__)
+    unknown = sorted(set(loose or {}) - set(names))
+    if unknown:
+        print(f"no such Landmark field: {', '.join(unknown)}")
+        return 2
+    loose = {names.index(k): v for k, v in (loose or {}).items()}
     with open(a_path, "rb") as fh:
         a = pickle.load(fh)
     with open(b_path, "rb") as fh:
@@ -86,7 +107,7 @@ def compare(a_path: str, b_path: str, rel: float) -> int:
             bad += 1
         for i, (fa, fb) in enumerate(zip(frames, b[key])):
             readings += len(fa[1])
-            if not _close(fa, fb, rel):
+            if not _close_frame(fa, fb, rel, loose):
                 bad += 1
                 if bad <= 10:
                     print(f"DIFF {key} frame {i}\n  {fa}\n  {fb}")
@@ -106,10 +127,19 @@ def main(argv: list | None = None) -> int:
     c.add_argument("a")
     c.add_argument("b")
     c.add_argument("--rel", type=float, default=0.0, help="relative tolerance for floats (default 0: bit for bit)")
+    c.add_argument("--loose", action="append", default=[], metavar="FIELD=REL",
+                   help="a Landmark field with its own relative tolerance (repeatable), e.g. range_sigma_m=1e-5")
     args = p.parse_args(argv)
     if args.cmd == "dump":
         return dump(args.out, args.config, args.sets, args.yuv)
-    return compare(args.a, args.b, args.rel)
+    loose = {}
+    for item in args.loose:
+        name, _, value = item.partition("=")
+        try:
+            loose[name] = float(value)
+        except ValueError:
+            p.error(f"--loose takes FIELD=REL, not {item!r}")
+    return compare(args.a, args.b, args.rel, loose)
 
 
 if __name__ == "__main__":

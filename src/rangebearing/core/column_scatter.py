@@ -19,7 +19,8 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from .edges import BG_ROWS, _column_sigma
+from . import edges
+from .edges import BG_ROWS
 
 #: one band: (which stack, its tile's first row in that stack, tile rows, tile columns,
 #: band level, background level, middle row, end row of the integral, inner edge below the band)
@@ -36,7 +37,7 @@ def column_sigmas(stacks: Sequence[np.ndarray], specs: Sequence[Scatter]) -> Lis
     Up to ``ALONE`` bands (one landmark) are measured one by one, exactly as :func:`.edges._column_sigma`.
     """
     if len(specs) <= ALONE:
-        return [_column_sigma(stacks[k][o : o + n, :m], level, bg, mid, end, down)
+        return [edges._column_sigma(stacks[k][o : o + n, :m], level, bg, mid, end, down)
                 for k, o, n, m, level, bg, mid, end, down in specs]
     order = sorted(range(len(specs)), key=lambda j: specs[j][0])  # the bands of each stack together
     t = np.asarray([specs[j] for j in order], np.float64)
