@@ -168,7 +168,8 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
 
 
 def balanced_search(
-    find: Callable[[Gains], Union[List[Candidate], Found]], bgr: np.ndarray, gains: Gains, max_landmarks: int
+    find: Callable[[Gains], Union[List[Candidate], Found]], bgr: np.ndarray, gains: Gains, max_landmarks: int,
+    relaxed: Optional[Callable[[Gains], Union[List[Candidate], Found]]] = None,
 ) -> Tuple[List[Candidate], Gains]:
     """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too
     (under a strong cast also :func:`halfway` between them); and the gains to measure them with:
@@ -180,6 +181,10 @@ def balanced_search(
     whose bands are among those regions (its body not white under these gains, a smaller piece of it
     found, a neighbour merged with it), and there is none. A frame with nothing found, or with
     band-coloured things no candidate explains, is searched under every balance as before.
+
+    ``relaxed(gains)``, when given, is the same search with the lower colour floors of
+    :func:`.color.relaxed_floors`: its landmarks are added where :func:`second_look` allows,
+    and the gains stay those of the landmarks found without it.
     """
     first = find(gains)
     cands = first.candidates if isinstance(first, Found) else first
@@ -189,7 +194,40 @@ def balanced_search(
         cands = merge_candidates(cands, _candidates(find(UNIT_GAINS)), max_landmarks)
     if not near_unit(gains, STRONG_CAST) and not done:
         cands = merge_candidates(cands, _candidates(find(halfway(gains))), max_landmarks)
-    return cands, white_body_gains(bgr, cands) or gains
+    measured = white_body_gains(bgr, cands) or gains
+    if relaxed is not None and len(cands) < max_landmarks:
+        cands = cands + second_look(cands, _candidates(relaxed(gains)))[: max_landmarks - len(cands)]
+    return cands, measured
+
+
+def second_look(found: Sequence[Candidate], more: Sequence[Candidate]) -> List[Candidate]:
+    """The candidates of a search with lower colour floors (``more``) that are landmarks the
+    searches at the normal floors missed: wholly apart from every one of ``found``, and ending in
+    a limb on at least one side.
+
+    Another camera's bands may fall under the class floors: a frame 1–2 stops under (white
+    bodies at V 20–40, bands at V 15–25), another maker's paler paint, chroma coded in 2×2
+    blocks. Lower floors frame-wide move the rims of every landmark found at the normal ones
+    (their boxes, cut flags and measured rows) and let in stripes: so a landmark found without
+    them keeps what the normal search made of it, and what the second look adds must not touch
+    it (its red-top-to-blue-bottom box overlaps none). A background's stripes (an orange brick
+    wall over a white skirting board over a blue floor, a dark skirting board read as a pale
+    blue band) run on beyond both sides of whatever the search cuts out of them: a candidate cut
+    on both sides is no second-look landmark, though a real one between two neighbours may be.
+    """
+    boxes = [_box(c) for c in found]
+    return [c for c in more if not (c.cut_left and c.cut_right) and not any(_meet(_box(c), b) for b in boxes)]
+
+
+def _box(c: Candidate) -> Tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` of a candidate from its red band's top to its blue band's bottom."""
+    x, y, w, _ = c.red_bbox_px
+    bx, by, bw, bh = c.blue_bbox_px
+    return min(x, bx), y, max(x + w, bx + bw), by + bh
+
+
+def _meet(a: Tuple[int, int, int, int], b: Tuple[int, int, int, int]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
 def _candidates(found: Union[List[Candidate], Found]) -> List[Candidate]:

@@ -175,6 +175,25 @@ def class_masks(
     return cv2.bitwise_and(hue_in(h, red_hue), sv), cv2.bitwise_and(hue_in(h, blue_hue), sv)
 
 
+# a second look (core/balance.py): the class floors another camera's darker or paler bands fall under
+RELAXED_S_SHARE = 2 / 3  # of s_min: paint ×0.7 saturation, 2×2 chroma blocks, a veil
+RELAXED_V_SHARE = 0.6  # of v_min: 1–2 stops under, a filmic toe
+RELAXED_WHITE_V = DARK  # the white body's least V (the column scan's is 40): a body 1–2 stops under
+
+
+def relaxed_floors(s_min: int, v_min: int) -> Tuple[int, int]:
+    """The saturation and value floors of the second look (:func:`.balance.second_look`) for ``s_min``, ``v_min``.
+
+    A camera that exposes 1–2 stops under, or whose tone curve has a deep toe,
+    leaves a white body at V 20–40 and a band at V 15–25; another maker's paint
+    (saturation ×0.7), a veil, or chroma coded in 2×2 blocks leave a band at
+    S 60–90. Frame-wide these floors let in the rims and stripes of everything
+    red or blue; they serve only a search whose candidates must stand apart from
+    every landmark found without them.
+    """
+    return round(s_min * RELAXED_S_SHARE), round(v_min * RELAXED_V_SHARE)
+
+
 @functools.lru_cache(maxsize=16)
 def ramp_table(lo: int, width: int) -> np.ndarray:
     """uint8 lookup table for ``cv2.LUT``: 0 up to ``lo``, rising linearly to 255 at ``lo + width``."""

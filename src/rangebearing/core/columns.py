@@ -158,7 +158,7 @@ STACK_WASTE = 4  # a window joins a stack of taller ones while it is at least 1/
 
 
 def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
-                split: Optional[Split] = None) -> List[List[RunStats]]:
+                split: Optional[Split] = None, white_v_min: int = WHITE_V_MIN) -> List[List[RunStats]]:
     """The runs of every pair window, searched together.
 
     The windows are put side by side, top-aligned, into a few stacked arrays
@@ -173,7 +173,8 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
     edges, window rows.
 
     ``split(runs, e1, e2, run_r, run_b)`` may cut the runs further on their
-    per-column edges and band runs (:func:`.fragments.split_runs`).
+    per-column edges and band runs (:func:`.fragments.split_runs`). ``white_v_min``: the
+    white body's least V (a second look at a dark frame takes less, see :mod:`.balance`).
     """
     out: List[List[RunStats]] = [[] for _ in wins]
     heights = [w[1] - w[0] for w in wins]
@@ -193,7 +194,7 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
             r[o : o + w, :h] = red[y0:y1, x0:x1].T
             b[o : o + w, :h] = blue[y0:y1, x0:x1].T
             sv[o : o + w, :h] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:].transpose(1, 0, 2)
-        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= WHITE_V_MIN)
+        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= white_v_min)
         ok, e1, e2, run_r, run_b = scan_columns(r > 0, b > 0, white)
         starts = offs[1:-1]
         ok, e1, e2 = bridge(ok, e1, e2, starts)

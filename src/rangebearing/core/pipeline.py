@@ -15,6 +15,7 @@ a full scan or in tracking windows).
 from __future__ import annotations
 
 import dataclasses
+import functools
 from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
@@ -160,15 +161,17 @@ class Pipeline:
                 y_half = half_luma(yuv.y) if yuv is not None else None
                 geometry = self.params.landmark
 
-                def find(gains: Gains) -> Found:
+                def find(gains: Gains, relaxed: bool = False) -> Found:
                     if yuv is None:
-                        return search_candidates(small, det, gains, ksize, geometry)
-                    return yuv_search(yuv, det, gains, ksize, geometry, y_half)
+                        return search_candidates(small, det, gains, ksize, geometry, relaxed)
+                    return yuv_search(yuv, det, gains, ksize, geometry, y_half, relaxed)
 
                 if det.white_balance == "grey_world":
                     grey = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
-                    # measured with the gains of the landmarks' own white bodies (see core/balance.py)
-                    cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks)
+                    # measured with the gains of the landmarks' own white bodies; a second look at lower
+                    # colour floors adds landmarks apart from those (see core/balance.py)
+                    cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks,
+                                                         functools.partial(find, relaxed=True))
                 else:
                     cands = find(self._gains).candidates
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)

@@ -32,7 +32,7 @@ from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
-from .columns import bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
+from .columns import WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .fragments import MIN_PIECE, Fragment, extend_along_bands, join_fragments, lit_like_bands, split_runs
 from .regions import MAX_REGIONS, band_regions, partnered, region_stats  # noqa: F401  (region cap lives there)
 from .types import BBox, LandmarkGeometry
@@ -118,6 +118,7 @@ def search(
     geometry: LandmarkGeometry,
     max_landmarks: int,
     min_area: int = 2,
+    white_v_min: int = WHITE_V_MIN,
 ) -> Found:
     """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
 
@@ -128,10 +129,11 @@ def search(
     pairs per landmark wanted are examined, whatever the frame holds.
 
     With them, ``explained()``: whether they explain every red and blue region of
-    the masks (:func:`explained`, judged only when asked).
+    the masks (:func:`explained`, judged only when asked). ``white_v_min``: the white
+    body's least V (:func:`.columns.window_runs`).
     """
     reds, blues = band_regions(red, blue, min_area)
-    found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks)
+    found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks, white_v_min)
     return Found(found, functools.partial(explained, reds, blues, found, scale))
 
 
@@ -171,7 +173,7 @@ def explained(reds: np.ndarray, blues: np.ndarray, found: Sequence[Candidate], s
 
 
 def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.ndarray, hsv: np.ndarray, scale: int,
-                geometry: LandmarkGeometry, max_landmarks: int) -> List[Candidate]:
+                geometry: LandmarkGeometry, max_landmarks: int, white_v_min: int = WHITE_V_MIN) -> List[Candidate]:
     """:func:`search` from the masks' regions (:func:`band_regions` of ``red`` and ``blue``)."""
     white_h = geometry.height_m - 2 * geometry.band_height_m
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
@@ -186,7 +188,7 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
     split = functools.partial(split_runs, band_k=band_k, width_k=width_k, merged_k=MERGED)
     frags: List[Fragment] = [
         (float(x0 + s0), float(x0 + s1), med_1 + y0, med_2 + y0, gap, med_r, med_b)
-        for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins, split))
+        for (y0, _, x0, _), found in zip(wins, window_runs(red, blue, hsv, wins, split, white_v_min))
         for s0, s1, gap, med_r, med_b, med_1, med_2 in found
         if s1 - s0 >= MIN_PIECE  # a column of edge noise neither makes nor joins a landmark
     ]

@@ -21,6 +21,7 @@ lookup when they are not within 2 % of one.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import Optional, Tuple
 
@@ -28,7 +29,7 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import UNIT_GAINS, Gains, grey_world_gains, to_hsv
+from .color import RELAXED_WHITE_V, UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
 from .denoise import band_masks
 from .params import DetectionParams
 from .structure import Found, search
@@ -250,15 +251,21 @@ class WindowHsv:
 
 def yuv_search(
     yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    y_half: Optional[np.ndarray] = None,
+    y_half: Optional[np.ndarray] = None, relaxed: bool = False,
 ) -> Found:
     """:func:`~rangebearing.core.detect.search_candidates` with the band search on the YUV420 planes.
 
     ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
-    full-resolution pixels of the frame the planes belong to.
+    full-resolution pixels of the frame the planes belong to. ``relaxed``: the second look's floors.
     """
     y_half = half_luma(yuv.y) if y_half is None else y_half
+    if relaxed:
+        s_min, v_min = relaxed_floors(cfg.s_min, cfg.v_min)
+        cfg = dataclasses.replace(cfg, s_min=s_min, v_min=v_min)
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
-    return search(red, blue, WindowHsv(y_half, yuv, gains), 2, geometry, cfg.max_landmarks, min_area)
+    hsv = WindowHsv(y_half, yuv, gains)
+    if relaxed:
+        return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
+    return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area)
