@@ -1,9 +1,19 @@
 """White balance from the landmarks' own white bodies, and the two-hypothesis search."""
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
 
-from rangebearing.core.balance import balanced_search, halfway, merge_candidates, near_unit, white_body_gains
+from rangebearing.core.balance import (
+    balanced_search,
+    halfway,
+    merge_candidates,
+    near_unit,
+    second_look,
+    white_body_gains,
+)
 from rangebearing.core.structure import Candidate
 
 
@@ -162,3 +172,46 @@ def test_other_balances_are_not_searched_when_the_first_found_landmarks_explaini
     seen.clear()
     balanced_search(find(True, []), img, grey, 8)  # nothing found: every balance, as before
     assert len(seen) == 3
+
+
+def test_the_second_look_adds_only_landmarks_apart_from_those_found():
+    found = [cand(20)]
+    apart, touching, striped = cand(100), cand(32), cand(60)
+    striped = dataclasses.replace(striped, cut_left=True, cut_right=True)  # stripes run on beyond both sides
+    one_side = dataclasses.replace(cand(130), cut_left=True)  # a real landmark beside a neighbour
+    assert second_look(found, [touching, apart, striped, one_side]) == [apart, one_side]
+
+
+def test_the_second_look_changes_neither_the_landmarks_found_nor_their_gains():
+    img, c = frame_with_body((120, 160, 200))
+    far = cand(120, w=10, band=4, white=12)
+    plain = balanced_search(lambda g: [c], img, (1.0, 1.0, 1.0), 8)
+    seen = []
+
+    def relaxed(gains, boxes):
+        seen.append(boxes)
+        return [dataclasses.replace(c, white_px=30.0), far]  # c's rims moved by the lower floors: not taken
+
+    more = balanced_search(lambda g: [c], img, (1.0, 1.0, 1.0), 8, relaxed=relaxed)
+    assert more[0] == [c, far] and more[1] == plain[1]  # the same c, measured with the same gains
+    assert seen == [[(60, 40, 80, 80)]]  # blind where c is: its box from red top to blue bottom
+    assert balanced_search(lambda g: [c], img, (1.0, 1.0, 1.0), 1, relaxed=lambda g, boxes: [far])[0] == [c]  # the cap
+
+
+def test_a_frame_two_and_a_half_stops_under_is_found_by_the_second_look():
+    from rangebearing import Pipeline, load_config
+    from rangebearing.core.detect import downscale, search_candidates
+    from rangebearing.synth import Imaging, LandmarkPose, Scene, render
+
+    params = load_config(None).pipeline
+    sc = Scene(landmarks=(LandmarkPose(0.9, 0.05),), imaging=Imaging(blur_sigma_px=0.6, read_noise=0.004,
+                                                                      shot_noise=0.0006), wall_distance_m=2.5)
+    img = render(sc, np.random.default_rng(3))
+    dark = np.round(img * 0.15).astype(np.uint8)  # white body at V ~34, bands at V ~15-25
+    small = downscale(dark, 2)
+    det, geometry = params.detection, params.landmark
+    assert search_candidates(small, det, (1.0, 1.0, 1.0), 3, geometry).candidates == []  # under the floors
+    assert len(search_candidates(small, det, (1.0, 1.0, 1.0), 3, geometry, relaxed=[]).candidates) == 1
+    (lm,) = Pipeline(params, track=False).process(dark).landmarks
+    assert lm.range_m == pytest.approx(0.9, rel=0.01)
+    assert abs(lm.bearing_rad - 0.05) < math.radians(0.15)

@@ -2,7 +2,7 @@ import cv2
 import numpy as np
 import pytest
 
-from rangebearing.core.denoise import band_masks, band_preserving_ksize, majority_filter, median_filter, regrow
+from rangebearing.core.denoise import band_masks, band_preserving_ksize, blanked, majority_filter, median_filter, regrow
 
 
 @pytest.mark.parametrize("k", [3, 5, 7, 15])
@@ -71,3 +71,11 @@ def test_regrow_keeps_what_the_filter_filled_in():
     raw[4, 4] = 0  # pepper inside a solid region
     out = regrow(majority_filter(raw, 3), raw, 3)
     assert out[4, 4] == 255
+
+
+def test_blanked_clears_each_box_grown_by_one_mask_pixel_and_nothing_else():
+    mask = np.full((20, 30), 255, np.uint8)
+    out = blanked(mask, [(10, 8, 15, 13)], 2)  # full-res columns 10-14, rows 8-12 -> mask cols 5-7, rows 4-6
+    assert (out[3:8, 4:9] == 0).all()  # grown by one: rows 3-7, cols 4-8
+    assert np.count_nonzero(out == 0) == 5 * 5
+    assert (mask == 255).all() and blanked(mask, [], 2) is mask  # the input is never changed

@@ -29,6 +29,7 @@ from typing import Callable, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from .color import CLIPPED, DARK, UNIT_GAINS, Gains
+from .denoise import Box
 from .stats import median_rows
 from .structure import Candidate, Found
 
@@ -169,7 +170,7 @@ def white_body_gains(bgr: np.ndarray, cands: Sequence[Candidate], limit: float =
 
 def balanced_search(
     find: Callable[[Gains], Union[List[Candidate], Found]], bgr: np.ndarray, gains: Gains, max_landmarks: int,
-    relaxed: Optional[Callable[[Gains], Union[List[Candidate], Found]]] = None,
+    relaxed: Optional[Callable[[Gains, List[Box]], Union[List[Candidate], Found]]] = None,
 ) -> Tuple[List[Candidate], Gains]:
     """Candidates under the grey-world ``gains`` and, unless those are near one, under unit gains too
     (under a strong cast also :func:`halfway` between them); and the gains to measure them with:
@@ -182,9 +183,10 @@ def balanced_search(
     found, a neighbour merged with it), and there is none. A frame with nothing found, or with
     band-coloured things no candidate explains, is searched under every balance as before.
 
-    ``relaxed(gains)``, when given, is the same search with the lower colour floors of
-    :func:`.color.relaxed_floors`: its landmarks are added where :func:`second_look` allows,
-    and the gains stay those of the landmarks found without it.
+    ``relaxed(gains, boxes)``, when given, is the same search with the lower colour floors of
+    :func:`.color.relaxed_floors`, blind inside the ``(x0, y0, x1, y1)`` boxes of the landmarks
+    found: its landmarks are added where :func:`second_look` allows, and the gains stay those of
+    the landmarks found without it.
     """
     first = find(gains)
     cands = first.candidates if isinstance(first, Found) else first
@@ -196,7 +198,8 @@ def balanced_search(
         cands = merge_candidates(cands, _candidates(find(halfway(gains))), max_landmarks)
     measured = white_body_gains(bgr, cands) or gains
     if relaxed is not None and len(cands) < max_landmarks:
-        cands = cands + second_look(cands, _candidates(relaxed(gains)))[: max_landmarks - len(cands)]
+        more = _candidates(relaxed(gains, [_box(c) for c in cands]))
+        cands = cands + second_look(cands, more)[: max_landmarks - len(cands)]
     return cands, measured
 
 
@@ -219,14 +222,14 @@ def second_look(found: Sequence[Candidate], more: Sequence[Candidate]) -> List[C
     return [c for c in more if not (c.cut_left and c.cut_right) and not any(_meet(_box(c), b) for b in boxes)]
 
 
-def _box(c: Candidate) -> Tuple[int, int, int, int]:
+def _box(c: Candidate) -> Box:
     """``(x0, y0, x1, y1)`` of a candidate from its red band's top to its blue band's bottom."""
     x, y, w, _ = c.red_bbox_px
     bx, by, bw, bh = c.blue_bbox_px
     return min(x, bx), y, max(x + w, bx + bw), by + bh
 
 
-def _meet(a: Tuple[int, int, int, int], b: Tuple[int, int, int, int]) -> bool:
+def _meet(a: Box, b: Box) -> bool:
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 

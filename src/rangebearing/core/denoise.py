@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import math
+from typing import Sequence, Tuple
 
 import cv2
 import numpy as np
+
+Box = Tuple[int, int, int, int]  # x0, y0, x1, y1 in full-resolution pixels
 
 
 def median_filter(image: np.ndarray, ksize: int) -> np.ndarray:
@@ -67,3 +70,15 @@ def regrow(filtered: np.ndarray, raw: np.ndarray, ksize: int) -> np.ndarray:
 def band_masks(red: np.ndarray, blue: np.ndarray, ksize: int) -> tuple:
     """The red and blue class masks denoised for the region search: majority filter, then :func:`regrow`."""
     return (regrow(majority_filter(red, ksize), red, ksize), regrow(majority_filter(blue, ksize), blue, ksize))
+
+
+def blanked(mask: np.ndarray, boxes: Sequence[Box], scale: int) -> np.ndarray:
+    """``mask`` (0/255, downscaled by ``scale``) with every ``(x0, y0, x1, y1)`` box (full-resolution
+    pixels) cleared, grown by one mask pixel; ``mask`` itself when there is none (else a copy)."""
+    if not boxes:
+        return mask
+    out = mask.copy()
+    for x0, y0, x1, y1 in boxes:  # floor the start, ceil the end, one pixel more each way
+        r0, r1 = max(0, y0 // scale - 1), max(0, -(-y1 // scale) + 1)
+        out[r0:r1, max(0, x0 // scale - 1) : max(0, -(-x1 // scale) + 1)] = 0
+    return out

@@ -28,7 +28,7 @@ import numpy as np
 from .._compat import frozen
 from .blobs import mask_centroid
 from .color import RELAXED_WHITE_V, Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
-from .denoise import band_masks, median_filter
+from .denoise import Box, band_masks, blanked, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
@@ -97,17 +97,19 @@ WHITE_SLACK_PX = 2.0
 
 def search_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    relaxed: bool = False,
+    relaxed: Optional[Sequence[Box]] = None,
 ) -> Found:
     """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
-    band-coloured region (:func:`.structure.search`). ``relaxed``: with the second look's lower
-    saturation and value floors (:func:`.color.relaxed_floors`, :func:`.balance.second_look`)."""
+    band-coloured region (:func:`.structure.search`). ``relaxed``: the second look
+    (:func:`.balance.second_look`): lower saturation and value floors (:func:`.color.relaxed_floors`)
+    outside these ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found."""
     hsv = to_hsv(apply_gains(small, gains))
-    s_min, v_min = relaxed_floors(cfg.s_min, cfg.v_min) if relaxed else (cfg.s_min, cfg.v_min)
+    s_min, v_min = (cfg.s_min, cfg.v_min) if relaxed is None else relaxed_floors(cfg.s_min, cfg.v_min)
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, _clipped(small, gains))
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
-    if relaxed:
+    if relaxed is not None:
+        red, blue = blanked(red, relaxed, cfg.downscale), blanked(blue, relaxed, cfg.downscale)
         return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
     return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 

@@ -15,14 +15,13 @@ a full scan or in tracking windows).
 from __future__ import annotations
 
 import dataclasses
-import functools
 from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from .balance import balanced_search
 from .color import UNIT_GAINS, Gains, grey_world_gains
-from .denoise import band_preserving_ksize
+from .denoise import Box, band_preserving_ksize
 from .detect import BandCentroids, detect_paper, downscale, drop_stacked, refine, search_candidates
 from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
@@ -161,7 +160,7 @@ class Pipeline:
                 y_half = half_luma(yuv.y) if yuv is not None else None
                 geometry = self.params.landmark
 
-                def find(gains: Gains, relaxed: bool = False) -> Found:
+                def find(gains: Gains, relaxed: Optional[List[Box]] = None) -> Found:
                     if yuv is None:
                         return search_candidates(small, det, gains, ksize, geometry, relaxed)
                     return yuv_search(yuv, det, gains, ksize, geometry, y_half, relaxed)
@@ -170,8 +169,7 @@ class Pipeline:
                     grey = grey_world_gains(small) if yuv is None else yuv_grey_world_gains(yuv, y_half=y_half)
                     # measured with the gains of the landmarks' own white bodies; a second look at lower
                     # colour floors adds landmarks apart from those (see core/balance.py)
-                    cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks,
-                                                         functools.partial(find, relaxed=True))
+                    cands, self._gains = balanced_search(find, bgr, grey, det.max_landmarks, find)
                 else:
                     cands = find(self._gains).candidates
                 pyramid = Pyramid(bgr, small if det.downscale == 2 else None)

@@ -23,14 +23,14 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import Optional, Tuple
+from typing import Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
 
 from .._compat import frozen
 from .color import RELAXED_WHITE_V, UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
-from .denoise import band_masks
+from .denoise import Box, band_masks, blanked
 from .params import DetectionParams
 from .structure import Found, search
 from .types import LandmarkGeometry
@@ -251,21 +251,22 @@ class WindowHsv:
 
 def yuv_search(
     yuv: Yuv420, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    y_half: Optional[np.ndarray] = None, relaxed: bool = False,
+    y_half: Optional[np.ndarray] = None, relaxed: Optional[Sequence[Box]] = None,
 ) -> Found:
     """:func:`~rangebearing.core.detect.search_candidates` with the band search on the YUV420 planes.
 
     ``cfg.downscale`` must be 2 (the chroma planes' scale); candidates are in
-    full-resolution pixels of the frame the planes belong to. ``relaxed``: the second look's floors.
+    full-resolution pixels of the frame the planes belong to. ``relaxed``: the second look, as there.
     """
     y_half = half_luma(yuv.y) if y_half is None else y_half
-    if relaxed:
+    if relaxed is not None:
         s_min, v_min = relaxed_floors(cfg.s_min, cfg.v_min)
         cfg = dataclasses.replace(cfg, s_min=s_min, v_min=v_min)
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
     hsv = WindowHsv(y_half, yuv, gains)
-    if relaxed:
+    if relaxed is not None:
+        red, blue = blanked(red, relaxed, 2), blanked(blue, relaxed, 2)
         return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
     return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area)
