@@ -2,7 +2,15 @@ import cv2
 import numpy as np
 import pytest
 
-from rangebearing.core.denoise import band_masks, band_preserving_ksize, blanked, majority_filter, median_filter, regrow
+from rangebearing.core.denoise import (
+    band_masks,
+    band_preserving_ksize,
+    blanked,
+    both_outside,
+    majority_filter,
+    median_filter,
+    regrow,
+)
 
 
 @pytest.mark.parametrize("k", [3, 5, 7, 15])
@@ -79,3 +87,14 @@ def test_blanked_clears_each_box_grown_by_one_mask_pixel_and_nothing_else():
     assert (out[3:8, 4:9] == 0).all()  # grown by one: rows 3-7, cols 4-8
     assert np.count_nonzero(out == 0) == 5 * 5
     assert (mask == 255).all() and blanked(mask, [], 2) is mask  # the input is never changed
+
+
+def test_both_outside_needs_red_and_blue_beyond_every_box():
+    red, blue = np.zeros((20, 30), np.uint8), np.zeros((20, 30), np.uint8)
+    red[5, 6], blue[9, 6] = 255, 255  # a landmark's bands, inside the box below
+    box = [(10, 8, 15, 20)]  # full-res columns 10-14, rows 8-19
+    assert not both_outside(red, blue, box, 2)
+    red[5, 20] = 255
+    assert not both_outside(red, blue, box, 2)  # red beyond it, but no blue
+    blue[12, 25] = 255
+    assert both_outside(red, blue, box, 2) and both_outside(red, blue, [], 2)

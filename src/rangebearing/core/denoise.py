@@ -82,3 +82,9 @@ def blanked(mask: np.ndarray, boxes: Sequence[Box], scale: int) -> np.ndarray:
         r0, r1 = max(0, y0 // scale - 1), max(0, -(-y1 // scale) + 1)
         out[r0:r1, max(0, x0 // scale - 1) : max(0, -(-x1 // scale) + 1)] = 0
     return out
+
+
+def both_outside(red: np.ndarray, blue: np.ndarray, boxes: Sequence[Box], scale: int) -> bool:
+    """Whether both masks (0/255, downscaled by ``scale``) have a set pixel outside every box
+    (:func:`blanked`): only then can a landmark stand wholly apart from those boxes."""
+    return bool(cv2.countNonZero(blanked(red, boxes, scale))) and bool(cv2.countNonZero(blanked(blue, boxes, scale)))

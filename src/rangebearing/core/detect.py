@@ -28,7 +28,7 @@ import numpy as np
 from .._compat import frozen
 from .blobs import mask_centroid
 from .color import RELAXED_WHITE_V, Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
-from .denoise import Box, band_masks, blanked, median_filter
+from .denoise import Box, band_masks, both_outside, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
@@ -101,15 +101,17 @@ def search_candidates(
 ) -> Found:
     """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
     band-coloured region (:func:`.structure.search`). ``relaxed``: the second look
-    (:func:`.balance.second_look`): lower saturation and value floors (:func:`.color.relaxed_floors`)
-    outside these ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found."""
+    (:func:`.balance.second_look`) with lower saturation and value floors (:func:`.color.relaxed_floors`),
+    given the ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found: it is not
+    searched when the masks hold no red or no blue outside them (a landmark apart from them has both)."""
     hsv = to_hsv(apply_gains(small, gains))
     s_min, v_min = (cfg.s_min, cfg.v_min) if relaxed is None else relaxed_floors(cfg.s_min, cfg.v_min)
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, _clipped(small, gains))
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
     if relaxed is not None:
-        red, blue = blanked(red, relaxed, cfg.downscale), blanked(blue, relaxed, cfg.downscale)
+        if not both_outside(red, blue, relaxed, cfg.downscale):
+            return Found([], lambda: True)  # nothing to find: nothing unexplained
         return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
     return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import RELAXED_WHITE_V, UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
-from .denoise import Box, band_masks, blanked
+from .denoise import Box, band_masks, both_outside
 from .params import DetectionParams
 from .structure import Found, search
 from .types import LandmarkGeometry
@@ -267,6 +267,7 @@ def yuv_search(
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
     hsv = WindowHsv(y_half, yuv, gains)
     if relaxed is not None:
-        red, blue = blanked(red, relaxed, 2), blanked(blue, relaxed, 2)
+        if not both_outside(red, blue, relaxed, 2):
+            return Found([], lambda: True)  # nothing to find: nothing unexplained
         return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
     return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area)
