@@ -20,7 +20,7 @@ in place instead.
 
 from __future__ import annotations
 
-from typing import Any, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -97,14 +97,19 @@ WHITE_SLACK_PX = 2.0
 
 def search_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    relaxed: Optional[Sequence[Box]] = None,
+    relaxed: Optional[Sequence[Box]] = None, hsv_of: Optional[Dict[Gains, np.ndarray]] = None,
 ) -> Found:
     """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
     band-coloured region (:func:`.structure.search`). ``relaxed``: the second look
     (:func:`.balance.second_look`) with lower saturation and value floors (:func:`.color.relaxed_floors`),
     given the ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found: it is not
-    searched when the masks hold no red or no blue outside them (a landmark apart from them has both)."""
-    hsv = to_hsv(apply_gains(small, gains))
+    searched when the masks hold no red or no blue outside them (a landmark apart from them has both).
+    ``hsv_of``: the frame's HSV images by gains, kept for the searches after (the second look's)."""
+    hsv = None if hsv_of is None else hsv_of.get(gains)
+    if hsv is None:
+        hsv = to_hsv(apply_gains(small, gains))
+        if hsv_of is not None:
+            hsv_of[gains] = hsv
     s_min, v_min = (cfg.s_min, cfg.v_min) if relaxed is None else relaxed_floors(cfg.s_min, cfg.v_min)
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, _clipped(small, gains))
     red, blue = band_masks(red, blue, ksize)
@@ -112,7 +117,7 @@ def search_candidates(
     if relaxed is not None:
         if not both_outside(red, blue, relaxed, cfg.downscale):
             return Found([], lambda: True)  # nothing to find: nothing unexplained
-        return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
+        return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V, relaxed)
     return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 
 

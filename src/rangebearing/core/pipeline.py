@@ -160,9 +160,11 @@ class Pipeline:
                 y_half = half_luma(yuv.y) if yuv is not None else None
                 geometry = self.params.landmark
 
+                hsv_of: Dict[Gains, np.ndarray] = {}
+
                 def find(gains: Gains, relaxed: Optional[List[Box]] = None) -> Found:
                     if yuv is None:
-                        return search_candidates(small, det, gains, ksize, geometry, relaxed)
+                        return search_candidates(small, det, gains, ksize, geometry, relaxed, hsv_of)
                     return yuv_search(yuv, det, gains, ksize, geometry, y_half, relaxed)
 
                 if det.white_balance == "grey_world":

@@ -7,7 +7,7 @@ those that could pair with the other colour first, then the largest (see :mod:`.
 
 from __future__ import annotations
 
-from typing import Tuple
+from typing import Sequence, Tuple
 
 import cv2
 import numpy as np
@@ -69,3 +69,21 @@ def partnered(regions: np.ndarray, other: np.ndarray, below: bool) -> np.ndarray
 
 def _capped(st: np.ndarray, first: np.ndarray) -> np.ndarray:
     return st[np.lexsort((-st[:, 5], ~first))[:MAX_REGIONS]]  # partnered first, then by box area
+
+
+APART_MARGIN = 0.25  # a region within a found landmark's box grown by this share of its size (and 2 px) is its
+
+
+def outside(regions: np.ndarray, boxes: Sequence[Tuple[int, int, int, int]], scale: int) -> np.ndarray:
+    """The :func:`region_stats` rows (mask pixels) that do not lie within any ``(x0, y0, x1, y1)`` box
+    (full-resolution pixels) grown by ``APART_MARGIN`` of its size and 2 mask pixels: the regions
+    of a landmark found already (its bands and their rims under lower colour floors) are its own."""
+    if not len(regions) or not boxes:
+        return regions
+    b = np.asarray(boxes, np.float64) / scale
+    mx = np.maximum(2.0, APART_MARGIN * (b[:, 2] - b[:, 0]))
+    my = np.maximum(2.0, APART_MARGIN * (b[:, 3] - b[:, 1]))
+    rx0, ry0 = regions[:, 1, None], regions[:, 2, None]
+    rx1, ry1 = rx0 + regions[:, 3, None], ry0 + regions[:, 4, None]
+    inside = (rx0 >= b[:, 0] - mx) & (ry0 >= b[:, 1] - my) & (rx1 <= b[:, 2] + mx) & (ry1 <= b[:, 3] + my)
+    return regions[~inside.any(axis=1)]

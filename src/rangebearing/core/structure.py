@@ -34,7 +34,7 @@ import numpy as np
 from .._compat import frozen
 from .columns import WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .fragments import MIN_PIECE, Fragment, extend_along_bands, join_fragments, lit_like_bands, split_runs
-from .regions import MAX_REGIONS, band_regions, partnered, region_stats  # noqa: F401  (region cap lives there)
+from .regions import MAX_REGIONS, band_regions, outside, partnered, region_stats  # noqa: F401  (region cap there)
 from .types import BBox, LandmarkGeometry
 
 MAX_PAIRS_PER_LANDMARK = 4  # region pairs examined per landmark wanted
@@ -119,6 +119,7 @@ def search(
     max_landmarks: int,
     min_area: int = 2,
     white_v_min: int = WHITE_V_MIN,
+    apart: Sequence[Tuple[int, int, int, int]] = (),
 ) -> Found:
     """Landmark candidates in downscaled red/blue masks (0/255) and their HSV image.
 
@@ -130,9 +131,13 @@ def search(
 
     With them, ``explained()``: whether they explain every red and blue region of
     the masks (:func:`explained`, judged only when asked). ``white_v_min``: the white
-    body's least V (:func:`.columns.window_runs`).
+    body's least V (:func:`.columns.window_runs`). ``apart``: ``(x0, y0, x1, y1)`` boxes (full
+    resolution) of landmarks found already; regions that lie within one are not paired
+    (:func:`.regions.outside`; the second look of :mod:`.balance` wants landmarks apart from them).
     """
     reds, blues = band_regions(red, blue, min_area)
+    if apart:
+        reds, blues = outside(reds, apart, scale), outside(blues, apart, scale)
     found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks, white_v_min)
     return Found(found, functools.partial(explained, reds, blues, found, scale))
 

@@ -269,5 +269,5 @@ def yuv_search(
     if relaxed is not None:
         if not both_outside(red, blue, relaxed, 2):
             return Found([], lambda: True)  # nothing to find: nothing unexplained
-        return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V)
+        return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V, relaxed)
     return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area)
