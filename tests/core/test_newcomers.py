@@ -71,3 +71,36 @@ def test_a_landmark_driving_in_at_the_side_is_found_as_soon_as_a_full_scan_finds
             late += 1
     # a full scan every 8 frames alone would leave it unreported for several frames after it came in
     assert late <= 1
+
+
+def test_the_counts_are_classified_again_only_when_the_strips_change():
+    from rangebearing.core.newcomers import PROBE_CHANGE, side_view
+
+    cfg = DetectionParams()
+    img = frame()
+    paint_landmark(img, 0, 10)
+    first = side_view(img, cfg, UNIT, [])
+    assert first.counts == (5, 0)
+    rng = np.random.default_rng(0)
+    noisy = np.clip(img.astype(int) + rng.integers(-PROBE_CHANGE // 2, PROBE_CHANGE // 2 + 1, img.shape), 0, 255)
+    assert side_view(noisy.astype(np.uint8), cfg, UNIT, [], first) is first  # camera noise: the same counts
+    grown = img.copy()
+    paint_landmark(grown, 150, 160)  # something came in on the right
+    assert side_view(grown, cfg, UNIT, [], first).counts == (5, 5)
+    assert side_view(img, cfg, UNIT, [(0, 15, 12, 60)], first).counts == (0, 0)  # blanked otherwise: counted again
+    assert side_view(img, cfg, (1.2, 1.0, 0.8), [], first) is not first  # other gains classify otherwise
+
+
+def test_a_change_between_the_probe_rows_of_a_landmark_is_seen():
+    # the smallest thing that can come in, a far landmark alone (no robot below it), crosses probe rows
+    from rangebearing.core.newcomers import PROBE_STEP, side_view
+
+    cfg = DetectionParams()
+    img = frame(160, 240)
+    first = side_view(img, cfg, UNIT, [])
+    for top in range(0, 2 * PROBE_STEP):  # 15 mm bands over a 40 mm body: 20 rows at 2.2 m (fy 634 px)
+        far = img.copy()
+        far[100 + top : 104 + top, 150:160] = RED
+        far[104 + top : 116 + top, 150:160] = (230, 230, 230)
+        far[116 + top : 120 + top, 150:160] = BLUE
+        assert side_view(far, cfg, UNIT, [], first).counts == (0, 5)

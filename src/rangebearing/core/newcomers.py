@@ -16,15 +16,27 @@ column. Red and blue things at the side only raise the counts the scan
 records; they trigger nothing until they change. A landmark not yet findable
 when the scan runs is in the recorded counts, and triggers the next scan by
 growing further as it comes in.
+
+Between scans the counts are classified again only when the strips changed
+(:func:`side_view`): a probe of every ``PROBE_STEP``-th row of them is compared
+with the probe the counts were last made from, and when no probe pixel moved
+by more than ``PROBE_CHANGE`` levels and the same parts of the strips are
+blanked, the counts are the last ones. Anything that can come in (a robot
+with its landmark is more than 40 rows tall at 2.2 m) crosses several probe
+rows, and a band's colour against any background differs by far more than
+``PROBE_CHANGE``; camera noise stays below it. Reading the strips from a new
+frame is most of their cost (their rows are scattered over the frame's
+memory): the probe reads a quarter of them.
 """
 
 from __future__ import annotations
 
-from typing import Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import cv2
 import numpy as np
 
+from .._compat import frozen
 from .color import Gains, apply_gains, class_masks, to_hsv
 from .params import DetectionParams
 from .types import BBox
@@ -33,7 +45,21 @@ EDGE_STRIP_PX = 48  # full-resolution columns: 60 % of the nearest landmark's wi
 NEW_COLUMNS = 2  # half-resolution columns: 60 % of a landmark at 2 m is about 3
 MIN_PX = 2  # a column holds a colour when it has this many of its pixels (half resolution): not one noisy pixel
 
+PROBE_STEP = 8  # full-resolution rows between the change probe's rows (a robot crosses 5 or more of them)
+PROBE_CHANGE = 32  # a probe pixel that moved by more than this (any channel, 0-255) is a change of the strips
+
 SideCounts = Tuple[int, int]  # landmark-like columns on the left and on the right
+Cut = Tuple[int, int, int, int]  # a blanked part of the strips: half-resolution rows y0:y1, columns c0:c1
+
+
+@frozen
+class SideView:
+    """Side counts with what they were made from: the strips' change probe, the blanked parts, the gains."""
+
+    counts: SideCounts
+    probe: Optional[np.ndarray] = None  # (rows, 2·half, 3) uint8: every PROBE_STEP-th row of both strips
+    cuts: Tuple[Cut, ...] = ()
+    gains: Optional[Gains] = None
 
 
 def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> SideCounts:
@@ -54,27 +80,53 @@ def side_colour(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequ
     boxes : sequence of BBox
         Full-resolution boxes of the landmarks already known (blanked).
     """
+    return side_view(bgr, cfg, gains, boxes).counts
+
+
+def side_view(
+    bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox], last: Optional[SideView] = None
+) -> SideView:
+    """:func:`side_colour` with what its counts were made from; ``last``'s counts again when nothing changed.
+
+    ``last`` is the view of an earlier frame (of this size): when the strips' probe
+    rows moved by no more than ``PROBE_CHANGE`` since it, the same parts of them
+    are blanked and the gains are the same, its counts stand (see the module's notes).
+    """
     h, w = bgr.shape[:2]
     s = min(EDGE_STRIP_PX, w // 4) // 2 * 2
     if s < 2 or h < 2:
-        return (0, 0)
+        return SideView((0, 0))
     half = s // 2
+    cuts = _cuts(boxes, w, h, s)
+    probe = np.concatenate((bgr[::PROBE_STEP, :s:2], bgr[::PROBE_STEP, w - s :: 2]), axis=1)
+    if (last is not None and last.probe is not None and last.probe.shape == probe.shape and last.cuts == cuts
+            and last.gains == gains and cv2.norm(probe, last.probe, cv2.NORM_INF) <= PROBE_CHANGE):
+        return last
     size = (half, h // 2)  # every other pixel of each strip: the full scan's resolution
     strips = cv2.hconcat([cv2.resize(bgr[:, :s], size, interpolation=cv2.INTER_NEAREST),
                           cv2.resize(bgr[:, w - s :], size, interpolation=cv2.INTER_NEAREST)])
     red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    for y0, y1, c0, c1 in cuts:
+        red[y0:y1, c0:c1] = 0
+        blue[y0:y1, c0:c1] = 0
+    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    both = (n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX)
+    counts = (int(np.count_nonzero(both[:half])), int(np.count_nonzero(both[half:])))
+    return SideView(counts, probe, cuts, gains)
+
+
+def _cuts(boxes: Sequence[BBox], w: int, h: int, s: int) -> Tuple[Cut, ...]:
+    """The parts of the two strips (half resolution, left strip then right) that ``boxes`` blank."""
+    half = s // 2
+    out: List[Cut] = []
     for bx, by, bw, bh in boxes:
         y0, y1 = max(0, by // 2), max(0, -(-(by + bh) // 2))
         for x0, off in ((0, 0), (w - s, half)):  # the box's columns inside each strip
             c0, c1 = max(bx, x0), min(bx + bw, x0 + s)
             if c1 > c0 and y1 > y0:
-                cols = slice(off + (c0 - x0) // 2, off + -(-(c1 - x0) // 2))
-                red[y0:y1, cols] = 0
-                blue[y0:y1, cols] = 0
-    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
-    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
-    both = (n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX)
-    return int(np.count_nonzero(both[:half])), int(np.count_nonzero(both[half:]))
+                out.append((y0, y1, off + (c0 - x0) // 2, off + -(-(c1 - x0) // 2)))
+    return tuple(out)
 
 
 def came_in(now: SideCounts, recorded: SideCounts) -> bool:

@@ -27,7 +27,7 @@ from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
 from .model import in_envelope, reading
-from .newcomers import SideCounts, came_in, side_colour
+from .newcomers import SideCounts, SideView, came_in, side_view
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
@@ -96,6 +96,7 @@ class Pipeline:
         self._hidden: List[Hidden] = []
         self._since_scan = 0
         self._sides: SideCounts = (0, 0)
+        self._side_view: Optional[SideView] = None  # the strips' counts as last classified (core/newcomers.py)
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
         self._size: Optional[Tuple[int, int]] = None  # the frame size the tracks were found in
@@ -144,8 +145,7 @@ class Pipeline:
             tracking = self.track and self._tracks and self._since_scan < det.full_scan_every - 1
             # landmarks crossing, one coming out from behind another, or one coming into view: a full scan
             if (tracking and not crossing([*self._tracks, *tracks_of(self._hidden)])
-                    and not came_in(side_colour(bgr, det, self._gains, [t.reach_px for t in self._tracks]),
-                                    self._sides)):
+                    and not came_in(self._sides_now(bgr), self._sides)):
                 self._tracks, self._lost = step(
                     bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
                 )
@@ -187,7 +187,8 @@ class Pipeline:
                 self._tracks = rescanned(self._tracks, found, self._lost) if self.track else []
                 self._lost = []
                 if self.track:  # what the sides hold now, the landmarks found blanked (core/newcomers.py)
-                    self._sides = side_colour(bgr, det, self._gains, [t.reach_px for t in self._tracks])
+                    self._side_view = None
+                    self._sides = self._sides_now(bgr)
                 self._since_scan = 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M
@@ -245,6 +246,13 @@ class Pipeline:
                 raise
 
         return result, finish
+
+    def _sides_now(self, bgr: np.ndarray) -> SideCounts:
+        """The side strips' landmark-like columns, the followed landmarks blanked; classified again only when
+        the strips changed since they last were (:func:`.newcomers.side_view`)."""
+        boxes = [t.reach_px for t in self._tracks]
+        self._side_view = side_view(bgr, self.params.detection, self._gains, boxes, self._side_view)
+        return self._side_view.counts
 
     def _reading(self, c: BandCentroids, cam: CameraIntrinsics, bgr: np.ndarray) -> tuple:
         """A :class:`Landmark`'s fields up to ``visible``, in its order (the ids come after)."""
