@@ -163,11 +163,14 @@ def combine(
     fy_px: float,
     pyramid: Optional[Pyramid] = None,
     rows: Any = _MEASURE,
+    sigma_l_px: Optional[float] = None,
+    chroma_blur_px: Optional[float] = None,
 ) -> Optional[BandCentroids]:
     """One candidate's band centres from its moments (``red``, ``blue``) and its edges; ``None`` if a band is gone.
 
     ``rows``: what :func:`.measure.measure_rows` gives for the candidate at the bands'
-    mean column, when the caller measured all candidates' rows at once.
+    mean column, when the caller measured all candidates' rows at once. ``sigma_l_px``
+    (instead of the rows') and ``chroma_blur_px``: values the caller keeps (tracking, a full scan's).
     """
     if red is None or blue is None:
         return None
@@ -201,13 +204,14 @@ def combine(
         blue.mass_px,
         red.chroma_ref,
         blue.chroma_ref,
-        sigma_l_px=rows.sigma_l_px,
+        sigma_l_px=rows.sigma_l_px if sigma_l_px is None else sigma_l_px,
         sigma_x_px=sx,
         spread_l_px=row_spread_px(red.xy_px[1], rows.red_y_px, rows.red_merged,
                                   blue.xy_px[1], rows.blue_y_px, rows.blue_merged),
         visible=c.visible,
         candidate=c,
         moments_px=(red.xy_px, blue.xy_px),
+        chroma_blur_px=chroma_blur_px,
     )
 
 

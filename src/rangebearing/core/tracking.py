@@ -24,7 +24,7 @@ from .._compat import frozen
 from .color import Gains
 from .detect import BandCentroids, combine
 from .frame_edge import near_edge, recut
-from .measure import Rows, measure_rows_all
+from .measure import measure_rows_all
 from .pairing import PairingLimits
 from .params import DetectionParams
 from .refine import BandFix, Margin, measure_bands
@@ -182,9 +182,9 @@ def step(
         if cand is None:
             now: Optional[BandCentroids] = _moved_only(t.bands, _origin(t), red, blue)
         else:
-            now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, _noise(row_of[k], t.bands, cand))
-            if now is not None and t.bands.chroma_blur_px is not None:  # the camera's, as the last full scan saw it
-                now = dataclasses.replace(now, chroma_blur_px=t.bands.chroma_blur_px)
+            # the colour's blur is the camera's, as the last full scan saw it
+            now = combine(bgr, cand, red, blue, gains, geometry, fy_px, None, row_of[k], _noise(t.bands, cand),
+                          t.bands.chroma_blur_px)
         if now is None:
             continue
         kept.append(advance(t, now, (red.xy_px, blue.xy_px)))
@@ -192,18 +192,16 @@ def step(
     return _distinct(kept), [t for t in tracks if id(t) not in followed]
 
 
-def _noise(rows: Optional[Rows], before: BandCentroids, now: Candidate) -> Optional[Rows]:
-    """``rows`` with the edges' noise of ``before`` (``sigma_l_px``), for the width the landmark has ``now``.
+def _noise(before: BandCentroids, now: Candidate) -> float:
+    """The edges' noise (``sigma_l_px``) of ``before``, for the width the landmark has ``now``.
 
     The scatter of the per-column edges is the landmark's own pixel noise over its
     columns: it changes as slowly as its size does, so a full scan measures it and
     the tracked frames after it keep it, scaled as the standard error of a mean over
     the columns (1/√width). Tracked frames skip its per-band fit.
     """
-    if rows is None:
-        return None
     width_px = 0.5 * (now.red_bbox_px[2] + now.blue_bbox_px[2])
-    return dataclasses.replace(rows, sigma_l_px=before.sigma_l_px * math.sqrt(before.width_px / max(width_px, 1e-6)))
+    return before.sigma_l_px * math.sqrt(before.width_px / max(width_px, 1e-6))
 
 
 def _tight_margins(boxes: Sequence[BBox], cfg: DetectionParams) -> List[Margin]:
