@@ -27,14 +27,14 @@ from .edges import BG_ROWS
 Scatter = Tuple[int, int, int, int, float, float, int, int, bool]
 FEW_COLUMNS_SIGMA = 0.5  # what _column_sigma gives when fewer than 5 columns show the step
 _EYE = np.eye(3)
-ALONE = 2  # bands measured one by one: a batch costs about as many calls as two bands
+ALONE = 6  # up to this many bands one by one: cold, a batch costs about what seven bands do
 
 
 def column_sigmas(stacks: Sequence[np.ndarray], specs: Sequence[Scatter]) -> List[float]:
     """:func:`.edges._column_sigma` of every band in ``specs`` (see :data:`Scatter`), the bands' tiles
     lying in ``stacks`` (float32 arrays of one width, tiles one below the other from column 0).
 
-    Up to ``ALONE`` bands (one landmark) are measured one by one, exactly as :func:`.edges._column_sigma`.
+    Up to ``ALONE`` bands (three landmarks) are measured one by one, exactly as :func:`.edges._column_sigma`.
     """
     if len(specs) <= ALONE:
         return [edges._column_sigma(stacks[k][o : o + n, :m], level, bg, mid, end, down)
