@@ -13,14 +13,14 @@ to ``-s<seed>``, seeds pooled) it prints:
   that set's σ would have to be scaled for 95 % (below 1: σ too wide);
 * each term's mean share of the reading's σ² (the term's constant set to 0, the rest kept): range
   ``noise`` (NOISE_SHARE), ``spread`` (SPREAD_SHARE: the row estimators' disagreement, merged bands
-  included), ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
+  included), ``fit`` (FIT_SPREAD: of the bands placed from their edges alone), ``merged`` (MERGED_PX), ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
   ``floor`` (EDGE_FLOOR_PX, MODEL_FLOOR); bearing ``column``, ``spread``, ``shading``, ``hidden``,
   ``cut``, ``floor``.
 
 ``--share NAME=VALUE`` (a constant of ``core/uncertainty.py``, e.g. ``SPREAD_SHARE=0.7``; repeatable)
 recomputes every sigma from the kept inputs with that value and prints the cover again, so a re-fit
-can be tried on many sets without replaying them. Terms measured inside the detector
-(``MERGED_PX`` in the spread, the inputs themselves) are not re-evaluated.
+can be tried on many sets without replaying them (``row_spread_px``'s inputs are kept too, so
+``MERGED_PX`` and ``FIT_SPREAD`` count). The inputs themselves are not re-measured.
 """
 
 from __future__ import annotations
@@ -37,32 +37,50 @@ import numpy as np
 
 from rangebearing import Pipeline, load_config
 from rangebearing.cli.common import aligned_truth
+from rangebearing.core import detect as detect_module
 from rangebearing.core import pipeline as pipeline_module
 from rangebearing.core import uncertainty as u
 from rangebearing.evaluation.match import match_frame
 from rangebearing.sources.recorded import iter_recorded
 
-RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "blur": ("CHROMA_SHARE",),
+RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "fit": ("FIT_SPREAD",),
+               "merged": ("MERGED_PX",), "blur": ("CHROMA_SHARE",),
                "hidden": ("HIDDEN_SHARE_L",), "cut": ("CUT_SHARE_L", "SPLIT_SHARE_L"),
                "floor": ("EDGE_FLOOR_PX", "MODEL_FLOOR")}
 BEARING_TERMS = {"column": ("COLUMN_SHARE",), "spread": ("SPREAD_X_SHARE",), "shading": ("SHADING_SHARE",),
                  "hidden": ("HIDDEN_SHARE",), "cut": ("CUT_SHARE", "SPLIT_SHARE"), "floor": ("BEARING_FLOOR_RAD",)}
 
 
+SPREAD_ARG = 9  # reading_sigma's positional spread_l_px, as the pipeline passes it
+
+
 def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, float, float]]:
-    """``(reading_sigma's arguments, its keywords, true range, true bearing)`` of every matched reading."""
+    """``(reading_sigma's arguments, its keywords, true range, true bearing)`` of every matched reading.
+
+    The arguments are kept with the spread's own inputs (``row_spread_px``'s, found by its value)
+    in place of ``spread_l_px``, so ``MERGED_PX`` and ``FIT_SPREAD`` are re-evaluated too.
+    """
     kept: List[tuple] = []
-    original = pipeline_module.reading_sigma
+    spreads: Dict[float, tuple] = {}
+    original, original_spread = pipeline_module.reading_sigma, detect_module.row_spread_px
 
     def keeping(*args, **kwargs):  # the pipeline's own call, its inputs kept
         out = original(*args, **kwargs)
+        if len(args) > SPREAD_ARG and args[SPREAD_ARG] in spreads:
+            args = args[:SPREAD_ARG] + (Spread(spreads[args[SPREAD_ARG]]),) + args[SPREAD_ARG + 1 :]
         kept.append((args, kwargs, out))
+        return out
+
+    def spread_keeping(*args):
+        out = original_spread(*args)
+        spreads[out] = args
         return out
 
     truth = aligned_truth(folder, os.path.join(folder, "truth.csv"))
     pipe = Pipeline(load_config(config).pipeline, track=tracked)
     rows = []
     pipeline_module.reading_sigma = keeping
+    detect_module.row_spread_px = spread_keeping
     try:
         for name, image in iter_recorded(folder):
             kept.clear()
@@ -77,7 +95,16 @@ def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, f
                         break
     finally:
         pipeline_module.reading_sigma = original
+        detect_module.row_spread_px = original_spread
     return rows
+
+
+class Spread(tuple):
+    """``row_spread_px``'s arguments standing for the spread: evaluated with the constants of the moment."""
+
+
+def _evaluated(args: tuple) -> tuple:
+    return tuple(u.row_spread_px(*a) if isinstance(a, Spread) else a for a in args)
 
 
 def sigmas(rows: Sequence[tuple], zero: Sequence[str] = ()) -> np.ndarray:
@@ -86,7 +113,7 @@ def sigmas(rows: Sequence[tuple], zero: Sequence[str] = ()) -> np.ndarray:
     try:
         for name in zero:
             setattr(u, name, 0.0)
-        return np.array([u.reading_sigma(*args, **kwargs) for args, kwargs, _, _ in rows]).reshape(-1, 2)
+        return np.array([u.reading_sigma(*_evaluated(args), **kwargs) for args, kwargs, _, _ in rows]).reshape(-1, 2)
     finally:
         for name, value in saved.items():
             setattr(u, name, value)

@@ -10,6 +10,7 @@ import pytest
 
 from rangebearing import Config, Pipeline
 from rangebearing.core import uncertainty as u
+from rangebearing.core.types import LandmarkGeometry
 from rangebearing.synth import LandmarkPose, Scene, render
 
 
@@ -20,6 +21,37 @@ def test_row_spread_is_half_the_disagreement_of_the_two_estimators_per_band():
     assert u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False) == pytest.approx(math.hypot(0.2, 0.15))
     # a merged band's moment is not its own: its term is the inner-edge placement's
     assert u.row_spread_px(30.0, 10.0, True, 50.0, 50.0, False) == pytest.approx(u.MERGED_PX)
+
+
+def test_a_row_from_its_edges_alone_has_its_own_share_of_the_disagreement():
+    both = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False)
+    fits = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False, True, True)
+    assert fits == pytest.approx(math.hypot(0.4 * u.FIT_SPREAD, 0.3 * u.FIT_SPREAD))
+    assert fits < both  # the mean's error is half the disagreement; the edges' row errs less
+    one = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False, True, False)
+    assert one == pytest.approx(math.hypot(0.4 * u.FIT_SPREAD, 0.15))
+    # a merged band is placed from its inner edge whether or not it "fits"
+    assert u.row_spread_px(30.0, 10.0, True, 50.0, 50.0, False, True, True) == pytest.approx(u.MERGED_PX)
+
+
+def test_a_whole_landmark_near_the_camera_is_seen_whole():
+    """The outline of a cylinder is narrower than its white height times diameter/height by
+    sqrt((d - r)/(d + r)): a run that spans the outline is the whole landmark."""
+    g = LandmarkGeometry()
+    white_m = g.height_m - 2 * g.band_height_m
+    fy = 600.0
+    for d in (0.2, 0.5, 1.5):
+        white_px = fy * white_m / (d - g.radius_m)
+        outline_px = 2 * fy * g.radius_m / math.sqrt(d * d - g.radius_m**2)
+        searched = outline_px / (white_px * g.diameter_m / white_m)  # the run over what the search expected
+        assert searched < 1.0
+        assert u.silhouette_share(searched, white_px, white_px, fy, g) == pytest.approx(1.0, abs=2e-3)
+        half = u.silhouette_share(0.5 * searched, white_px, white_px, fy, g)
+        assert half == pytest.approx(0.5, abs=2e-3)  # a half-hidden one stays half
+    assert u.silhouette_share(1.0, 50.0, 52.0, fy, g) == 1.0
+    # the white height measured at full resolution replaces the search's mask-pixel one
+    white_px = fy * white_m / (0.5 - g.radius_m)
+    assert u.silhouette_share(0.8, white_px * 1.05, white_px, fy, g) > u.silhouette_share(0.8, white_px, white_px, fy, g)
 
 
 def test_range_sigma_follows_the_spacing_error_through_the_model():
@@ -74,6 +106,11 @@ def test_chroma_blur_is_the_colours_blur_beyond_the_brightness():
 
     alike = blur(_landmark_columns(0.0))
     assert 0.0 <= alike < 0.35
+    # pixel noise makes no blur: a sharp edge in noisy colour reads (close to) none on average
+    rng = np.random.default_rng(7)
+    sharp = _landmark_columns(0.0).astype(np.int16)
+    noisy = [blur(np.clip(sharp + rng.normal(0, 4, sharp.shape), 0, 255).astype(np.uint8)) for _ in range(12)]
+    assert float(np.mean(noisy)) < 0.17  # clipping each band's difference at zero read 0.23 here
     mild, strong = blur(_landmark_columns(0.8)), blur(_landmark_columns(1.6))
     assert alike < mild < strong
     assert strong > 1.0

@@ -34,7 +34,7 @@ from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
 from .structure import Candidate, Found, search
 from .types import XY, BBox, LandmarkGeometry, union
-from .uncertainty import row_spread_px
+from .uncertainty import row_spread_px, silhouette_share
 
 
 @frozen
@@ -207,8 +207,8 @@ def combine(
         sigma_l_px=rows.sigma_l_px if sigma_l_px is None else sigma_l_px,
         sigma_x_px=sx,
         spread_l_px=row_spread_px(red.xy_px[1], rows.red_y_px, rows.red_merged,
-                                  blue.xy_px[1], rows.blue_y_px, rows.blue_merged),
-        visible=c.visible,
+                                  blue.xy_px[1], rows.blue_y_px, rows.blue_merged, rows.red_fits, rows.blue_fits),
+        visible=silhouette_share(c.visible, c.white_px, rows.white_px, fy_px, geometry),
         candidate=c,
         moments_px=(red.xy_px, blue.xy_px),
         chroma_blur_px=chroma_blur_px,

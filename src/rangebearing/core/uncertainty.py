@@ -53,10 +53,12 @@ import numpy as np
 
 from .color import Gains
 from .edges import excess_luma, mean_along
+from .types import LandmarkGeometry
 
 # range: terms of the band spacing's error (px), each in quadrature
 NOISE_SHARE = 0.5  # column-scatter standard error of the inner edges → the spacing
 SPREAD_SHARE = 0.85  # share of the row estimators' disagreement (row_spread_px) that is error
+FIT_SPREAD = 0.2  # share of |moment − edge| a row from its edges alone errs by (the mean of both: 0.5)
 EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the outline's curve
 CHROMA_SHARE = 0.14  # per band centre, share of the colour's own blur (chroma_blur_px)
 MERGED_PX = 1.3  # a band placed from its inner edge and the white height (heights on a curved surface)
@@ -78,7 +80,12 @@ BAND_SHARE = 15.0 / 55.0  # a band's height over the band spacing
 
 
 def _edge_width(p: np.ndarray, at: float, rising: bool) -> float:
-    """Second-moment width (rows) of the step of profile ``p`` nearest row ``at``; NaN when there is none."""
+    """Second-moment width (rows) of the step of profile ``p`` nearest row ``at``; NaN when there is none.
+
+    The derivative's samples are weighted as they are, negative ones included: clipping them at
+    zero would give a noisy profile's tails a positive second moment, so a sharp but noisy edge
+    (colour excess is a difference of channels: noisier than luma) would read wider than it is.
+    """
     lo, hi = max(0, int(at) - EDGE_WINDOW_PX), min(len(p) - 1, int(at) + EDGE_WINDOW_PX)
     if hi - lo < 3:
         return math.nan
@@ -86,20 +93,13 @@ def _edge_width(p: np.ndarray, at: float, rising: bool) -> float:
     dl = d.tolist()
     j = dl.index(max(dl))  # np.argmax: the first largest
     dl = dl[max(0, j - EDGE_HALF_PX) : j + EDGE_HALF_PX + 1]
-    d = d[max(0, j - EDGE_HALF_PX) : j + EDGE_HALF_PX + 1]
-    d = np.maximum(d - max(0.0, min(dl[0], dl[-1])), 0.0)  # a shading slope under the step is no edge
-    total = float(d.sum())  # the profile's dtype, as numpy sums it
+    base = max(0.0, min(dl[0], dl[-1]))  # a shading slope under the step is no edge
+    dl = [v - base for v in dl]
+    total = math.fsum(dl)
     if total <= 1e-9:
         return math.nan
-    # the moments in Python on at most 7 rows: a numpy dot of this size sums in this order too
-    dl = d.tolist()
-    first = 0.0
-    for k, v in enumerate(dl):
-        first += k * v
-    m = first / total
-    second = 0.0
-    for k, v in enumerate(dl):
-        second += (k - m) * (k - m) * v
+    m = math.fsum(k * v for k, v in enumerate(dl)) / total
+    second = math.fsum((k - m) * (k - m) * v for k, v in enumerate(dl))
     return math.sqrt(max(second / total, 0.0))
 
 
@@ -115,8 +115,10 @@ def chroma_blur_px(
     The edges show it: each inner (band/white) edge's width in the band's colour excess
     and in luma, over the middle two thirds of the landmark's columns; the colour's own
     blur is ``sqrt(w_colour² − w_luma²)`` (blurs add in quadrature), averaged over the
-    two bands. Luma sharpening narrows the luma edge, which counts as colour blur too:
-    the colour planes are not sharpened.
+    two bands (``w_colour² − w_luma²`` averaged over the bands before it is clipped at zero:
+    on a camera with colour at luma's resolution the difference is noise around zero, and
+    clipping each band's would read a blur where there is none). Luma sharpening narrows the
+    luma edge, which counts as colour blur too: the colour planes are not sharpened.
     """
     return chroma_blur_all(bgr, [(red_xy_px, blue_xy_px, width_px)], gains)[0]
 
@@ -170,23 +172,51 @@ def chroma_blur_all(bgr: np.ndarray, bands: Sequence[Tuple[Tuple[float, float], 
                                     (mean_along(eb_all[rows, :m], 1), at_b, True)):
             wc, wl = _edge_width(p, at, colour_rises), _edge_width(luma, at, not colour_rises)
             if math.isfinite(wc) and math.isfinite(wl):
-                blur2.append(max(0.0, wc * wc - wl * wl))
-        out.append(math.sqrt(sum(blur2) / len(blur2)) if blur2 else 0.0)
+                blur2.append(wc * wc - wl * wl)
+        out.append(math.sqrt(max(0.0, sum(blur2) / len(blur2))) if blur2 else 0.0)
     return out
 
 
 def row_spread_px(
     moment_red_px: float, edge_red_px: float, red_merged: bool,
     moment_blue_px: float, edge_blue_px: float, blue_merged: bool,
+    red_fits: bool = False, blue_fits: bool = False,
 ) -> float:
     """One-sigma error (px) of the band spacing from the two row estimators of each band.
 
-    A band measured both ways contributes ``(moment − edge)²/4``; a merged band, whose
-    moment is not its own, contributes ``MERGED_PX²`` instead.
+    A band whose row is the mean of its moment and its edges' row contributes
+    ``(moment − edge)²/4``; a band placed from its edges alone (``*_fits``: its edges span
+    the landmark's band height, :meth:`.measure.Rows.band_y`) errs by less than that mean,
+    ``(FIT_SPREAD · (moment − edge))²``; a merged band, whose moment is not its own,
+    contributes ``MERGED_PX²`` instead.
     """
-    red = MERGED_PX**2 if red_merged else 0.25 * (moment_red_px - edge_red_px) ** 2
-    blue = MERGED_PX**2 if blue_merged else 0.25 * (moment_blue_px - edge_blue_px) ** 2
-    return math.sqrt(red + blue)
+    terms = []
+    for moment, edge, merged, fits in ((moment_red_px, edge_red_px, red_merged, red_fits),
+                                       (moment_blue_px, edge_blue_px, blue_merged, blue_fits)):
+        share = FIT_SPREAD if fits else 0.5
+        terms.append(MERGED_PX**2 if merged else (share * (moment - edge)) ** 2)
+    return math.sqrt(terms[0] + terms[1])
+
+
+def silhouette_share(visible: float, search_white_px: float, white_px: float, fy_px: float,
+                     geometry: LandmarkGeometry) -> float:
+    """``visible`` (the structure search's run width over the silhouette it expected) against the
+    silhouette this landmark really has, at most 1.
+
+    The search expects a silhouette ``diameter/white height`` times its white body's height in
+    mask pixels (``search_white_px``, in full-resolution pixels). A cylinder's outline is
+    narrower than that, by ``sqrt((d − r)/(d + r))`` at distance ``d`` (the white body's height
+    is seen at its front, ``d − r``; the outline spans the tangents, ``2r/sqrt(d² − r²)``): 1.7 %
+    at 1 m, 8 % at 0.2 m. So a whole landmark near the camera read 0.92-0.97 "visible"; with
+    the white height measured at full resolution (``white_px``) and its range, it reads whole.
+    """
+    if visible >= 1.0 or white_px <= 0.0:
+        return visible
+    white_m = geometry.height_m - 2.0 * geometry.band_height_m
+    r = geometry.radius_m
+    d = fy_px * white_m / white_px + r
+    outline = math.sqrt(max(d - r, 0.0) / (d + r))
+    return min(1.0, visible * search_white_px / max(white_px * outline, 1e-6))
 
 
 def range_sigma_m(
