@@ -13,7 +13,8 @@ to ``-s<seed>``, seeds pooled) it prints:
   that set's σ would have to be scaled for 95 % (below 1: σ too wide);
 * each term's mean share of the reading's σ² (the term's constant set to 0, the rest kept): range
   ``noise`` (NOISE_SHARE), ``spread`` (SPREAD_SHARE: the row estimators' disagreement, merged bands
-  included), ``fit`` (FIT_SPREAD: of the bands placed from their edges alone), ``merged`` (MERGED_PX), ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
+  included), ``fit`` (FIT_SPREAD: of the bands placed from their edges alone), ``merged`` (MERGED_PX),
+  ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
   ``floor`` (EDGE_FLOOR_PX, MODEL_FLOOR); bearing ``column``, ``spread``, ``shading``, ``hidden``,
   ``cut``, ``floor``.
 
@@ -67,7 +68,7 @@ def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, f
     def keeping(*args, **kwargs):  # the pipeline's own call, its inputs kept
         out = original(*args, **kwargs)
         if len(args) > SPREAD_ARG and args[SPREAD_ARG] in spreads:
-            args = args[:SPREAD_ARG] + (Spread(spreads[args[SPREAD_ARG]]),) + args[SPREAD_ARG + 1 :]
+            args = (*args[:SPREAD_ARG], Spread(spreads[args[SPREAD_ARG]]), *args[SPREAD_ARG + 1 :])
         kept.append((args, kwargs, out))
         return out
 

@@ -51,7 +51,8 @@ def test_a_whole_landmark_near_the_camera_is_seen_whole():
     assert u.silhouette_share(1.0, 50.0, 52.0, fy, g) == 1.0
     # the white height measured at full resolution replaces the search's mask-pixel one
     white_px = fy * white_m / (0.5 - g.radius_m)
-    assert u.silhouette_share(0.8, white_px * 1.05, white_px, fy, g) > u.silhouette_share(0.8, white_px, white_px, fy, g)
+    coarse = u.silhouette_share(0.8, white_px * 1.05, white_px, fy, g)
+    assert coarse > u.silhouette_share(0.8, white_px, white_px, fy, g)
 
 
 def test_range_sigma_follows_the_spacing_error_through_the_model():

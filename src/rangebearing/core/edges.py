@@ -1,18 +1,16 @@
 """Sub-pixel band edges in linear light: where each band starts and ends, row by row and column by column.
 
-In linear light a pixel straddling an edge is the coverage-weighted mix of
-its two sides, so any channel combination is linear in coverage. The excess
-``R − (G+B)/2`` (red) or ``B − (R+G)/2`` (blue) is the paint's level inside a
-band and the background's level outside it, and the edge between two rows
-``a`` (inside) and ``b`` (outside) lies at::
+In linear light a pixel straddling an edge is the coverage-weighted mix of its two sides, so any channel
+combination is linear in coverage. The excess ``R − (G+B)/2`` (red) or ``B − (R+G)/2`` (blue) is the paint's
+level inside a band and the background's level outside it, and the edge between two rows ``a`` (inside) and
+``b`` (outside) lies at::
 
     edge = (a − ½) + Σ_{y=a..b} (p(y) − bg) / (level − bg)      (going down)
 
-for any symmetric blur: the two-level integral. A band's centre is the mean
-of its two edges when both are its own; when its outer edge merges with a
-background of its colour (``level − bg`` small), the inner edge and the white
-body's height place it instead, since on the cylinder's near surface heights
-map linearly to rows. The sRGB-like encoding is undone with a 2.2 power.
+for any symmetric blur: the two-level integral. A band's centre is the mean of its two edges when both are its
+own; when its outer edge merges with a background of its colour (``level − bg`` small), the inner edge and the
+white body's height place it instead, since on the cylinder's near surface heights map linearly to rows. The
+sRGB-like encoding is undone with a 2.2 power.
 """
 
 from __future__ import annotations
@@ -31,6 +29,7 @@ from .stats import median
 GAMMA = 2.2
 BG_ROWS = 4  # rows averaged for a background level
 STEP_MIN, STEP_SHARE, STEP_NOISE = 0.02, 0.3, 0.005  # see step_floor
+RHO_MAX = 0.8  # the columns' lag-1 error correlation counted at most (_column_sigma; from ~10-40 columns)
 MERGE_CONTRAST = 0.5  # an outer edge whose level step is below this share of the band's level is merged
 
 
@@ -157,11 +156,11 @@ def _level_beyond(p: np.ndarray, row: int, down: bool, rows: int = BG_ROWS) -> f
 def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, down: bool) -> float:
     """Standard error of the inner edge from the scatter of the per-column edges (rows).
 
-    Each column's edge is its own two-level integral (its own band level and
-    background: shading across the cylinder and the profile's weighting of the end
-    columns scale a column, they do not move its edge), and the scatter is taken
-    about a parabola through them: seen from below or above the band, an edge is
-    an arc of an ellipse, a smooth curve that is no noise.
+    Each column's edge is its own two-level integral (its own band level and background: shading across the
+    cylinder and the profile's weighting of the end columns scale a column, they do not move its edge), and the
+    scatter is taken about a parabola through them: seen from below or above the band, an edge is an arc of an
+    ellipse, a smooth curve that is no noise. Neighbouring columns' errors correlate (lag-1 ``ρ`` of the
+    residuals) where the camera mixes pixels across them (demosaic, chroma subsampling, denoise, video blocks).
     """
     lo, hi = (mid, end) if down else (end, mid)
     beyond = p2d[end : end + BG_ROWS] if down else p2d[max(0, end - BG_ROWS + 1) : end + 1]
@@ -176,7 +175,8 @@ def _column_sigma(p2d: np.ndarray, level: float, bg: float, mid: int, end: int, 
     sums = np.add.reduce(p2d[lo : hi + 1, ok] - bgc[ok], axis=0) / step[ok]
     a, aa = _curve_basis(idx.tobytes())
     res = sums - np.float32(np.add.reduce(sums) / np.intp(cols)) - (a @ sums / aa) @ a
-    return math.sqrt(float(res @ res) / (cols - 3)) / math.sqrt(cols)  # IEEE square roots, as numpy's
+    rho = min(RHO_MAX, max(-RHO_MAX, float(res[:-1] @ res[1:]) / max(float(res @ res), 1e-30)))  # (1+ρ)/(1−ρ): the
+    return math.sqrt(float(res @ res) / (cols - 3) * (1.0 + rho) / (1.0 - rho)) / math.sqrt(cols)  # mean's variance
 
 
 @functools.lru_cache(maxsize=512)
