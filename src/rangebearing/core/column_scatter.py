@@ -10,7 +10,9 @@ about forty calls however many bands it has.
 The columns that take part and the levels that choose them are those of
 :func:`.edges._column_sigma` bit for bit (the same float32 sums); the integrals
 and the fit are summed in float64, so a sigma differs from the band-by-band
-one only in its last bits (about 1e-7 relative).
+one only in its last bits (about 1e-7 relative). The residuals' lag-1 correlation
+is taken over the columns taking part, packed side by side as the band-by-band
+residuals are.
 """
 
 from __future__ import annotations
@@ -75,9 +77,18 @@ def column_sigmas(stacks: Sequence[np.ndarray], specs: Sequence[Scatter]) -> Lis
     gram = basis @ basis.transpose(0, 2, 1)
     gram[cols < 5] = _EYE  # too few columns: no fit (FEW_COLUMNS_SIGMA)
     proj = basis @ s[:, :, None]
-    rss = np.add.reduce(s * s, axis=1) - np.add.reduce(proj * np.linalg.solve(gram, proj), axis=(1, 2))
+    coef = np.linalg.solve(gram, proj)
+    rss = np.add.reduce(s * s, axis=1) - np.add.reduce(proj * coef, axis=(1, 2))
     rss = np.maximum(rss, 0.0)
-    sigma = np.sqrt(rss / np.maximum(cols - 3, 1)) / np.sqrt(count)
+    # the residuals' lag-1 correlation over the columns taking part, next to each other as edges takes them
+    res = s - np.add.reduce(basis * coef, axis=1)
+    packed = np.zeros_like(res)
+    b, c = np.nonzero(ok)
+    packed[b, (np.cumsum(ok, axis=1) - 1)[b, c]] = res[b, c]
+    lag = np.add.reduce(packed[:, :-1] * packed[:, 1:], axis=1) / np.maximum(np.add.reduce(packed * packed, axis=1),
+                                                                             1e-30)
+    rho = np.clip(lag, -edges.RHO_MAX, edges.RHO_MAX)
+    sigma = np.sqrt(rss / np.maximum(cols - 3, 1) * (1.0 + rho) / (1.0 - rho)) / np.sqrt(count)
     out = [0.0] * len(specs)
     for j, v, c in zip(order, sigma.tolist(), cols.tolist()):
         out[j] = v if c >= 5 else FEW_COLUMNS_SIGMA
