@@ -57,22 +57,22 @@ from .types import LandmarkGeometry
 
 # range: terms of the band spacing's error (px), each in quadrature
 NOISE_SHARE = 0.5  # column-scatter standard error of the inner edges → the spacing
-SPREAD_SHARE = 1.42  # share of the row estimators' disagreement (row_spread_px) that is error
-FIT_SPREAD = 0.242  # share of |moment − edge| a row from its edges alone errs by (the mean of both: 0.5)
+SPREAD_SHARE = 1.75  # share of the row estimators' disagreement (row_spread_px) that is error
+FIT_SPREAD = 0.21  # share of |moment − edge| a row from its edges alone errs by (the mean of both: 0.5)
 EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the outline's curve
-CHROMA_SHARE = 0.131  # per band centre, share of the colour's own blur (chroma_blur_px)
-MERGED_PX = 1.07  # a band placed from its inner edge and the white height (heights on a curved surface)
-HIDDEN_SHARE_L = 0.0365  # share of L per unit of hidden share (the edges' curve over the visible part)
-SPLIT_SHARE_L = 0.0147  # share of L: a landmark cut on both sides (split between neighbours)
-CUT_SHARE_L = 0.0158  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
+CHROMA_SHARE = 0.11  # per band centre, share of the colour's own blur (chroma_blur_px)
+MERGED_PX = 1.42  # a band placed from its inner edge and the white height (heights on a curved surface)
+HIDDEN_SHARE_L = 0.138  # share of L per unit of hidden share (the edges' curve over the visible part)
+SPLIT_SHARE_L = 0.00596  # share of L: a landmark cut on both sides (split between neighbours)
+CUT_SHARE_L = 0.00286  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
 MODEL_FLOOR = 0.0002  # relative range error left after calibration
 # bearing: terms of the column's error (px)
 COLUMN_SHARE = 1.21  # of the column measurement's own error (moments, or a limb and half a silhouette)
 SPREAD_X_SHARE = 2.58  # of half the red and blue bands' column difference
-SHADING_SHARE = 0.00238  # column bias from shading across the cylinder, share of the silhouette width
-HIDDEN_SHARE = 0.279  # column error per unit of hidden share, in silhouette widths (the visible part's centre)
-SPLIT_SHARE = 0.0324  # column error of a landmark cut on both sides (split between neighbours), share of its width
-CUT_SHARE = 0.0712  # column error of a landmark cut on one side (placed from its other limb), share of its width
+SHADING_SHARE = 0.00255  # column bias from shading across the cylinder, share of the silhouette width
+HIDDEN_SHARE = 0.252  # column error per unit of hidden share, in silhouette widths (the visible part's centre)
+SPLIT_SHARE = 0.0303  # column error of a landmark cut on both sides (split between neighbours), share of its width
+CUT_SHARE = 0.079  # column error of a landmark cut on one side (placed from its other limb), share of its width
 BEARING_FLOOR_RAD = 5e-5  # 0.003°: the outline correction and the undistortion
 EDGE_WINDOW_PX = 5  # rows searched each side of a band's expected inner edge for its steepest step
 EDGE_HALF_PX = 3  # rows each side of that step whose derivative makes the edge's width
