@@ -30,6 +30,8 @@ LIMB_SIGMA_X_PX = 0.8  # a limb edge on a shaded cylinder side
 OUTLINE_ITERATIONS = 4  # fixed-point steps for the axis angle (each gains about two decimal places)
 LIMB_AGREE_PX = 1.5  # the two bands' limbs of one cylinder agree within this; farther apart, one was widened
 MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
+HIDDEN_BELOW = 0.95  # a candidate cut on both sides seen narrower than this share of its silhouette is partly hidden
+WHOLE_WIDTH = 0.1  # two limbs this close (relative) to a whole outline apart are both natural
 FRAME_EDGE_PX = 2  # a run starting this close to the frame's edge (½-resolution columns) may be cut by it
 
 
@@ -69,54 +71,84 @@ def measure_columns(
     rows: Rows,
     pyramid: Optional[Pyramid] = None,
 ) -> Optional[Tuple[float, float]]:
-    """``(x_px, sigma_x_px)`` of a landmark cut on exactly one side, from its other limb; else ``None``.
+    """``(x_px, sigma_x_px)`` of a landmark cut on a side, from a limb; ``None``: keep the moments.
 
-    Both bands' limbs are measured (:func:`.edges.limb`); they are one cylinder's
-    outline, so when they disagree the inner one wins (a same-coloured band beside
-    it only ever widens a band). ``x_px`` is the outline's centre, the column the
-    model expects (:func:`.model.axis_bearing` takes it to the axis), placed from
-    the limb by :func:`outline_centre`.
+    Cut on exactly one side: placed from its other limb. Both bands' limbs are
+    measured (:func:`.edges.limb`); they are one cylinder's outline, so when they
+    disagree the inner one wins (a same-coloured band beside it only ever widens a
+    band). ``x_px`` is the outline's centre, the column the model expects
+    (:func:`.model.axis_bearing` takes it to the axis), placed from the limb by
+    :func:`outline_centre`.
+
+    Marked cut on both sides by the structure search and partly hidden (``visible`` below ``HIDDEN_BELOW``):
+    the moments of what is left lie off the axis by up to half the hidden part, so
+    a limb places it where one side shows one: where only one side falls off to a
+    background like a limb (the other runs on into a same-coloured band in front),
+    from that one; where both do and they lie a whole outline apart, from their
+    midpoint. Where both fall off closer together (something of another colour in
+    front on one side) the side is not known: the moments stand.
     """
     cut_left, cut_right = cut_sides(c, bgr.shape[1])
-    if cut_left == cut_right:
+    if not (cut_left or cut_right):
         return None
-    white_m = geometry.height_m - 2 * geometry.band_height_m
-    band_px = rows.white_px * geometry.band_height_m / white_m
     rx, _, rw, _ = c.red_bbox_px
+    if cut_left and cut_right and not (c.cut_left and c.cut_right and c.visible < HIDDEN_BELOW):
+        return None  # whole, or the frame's edge cuts a side: no limb there, none known on the other
+    white_m = geometry.height_m - 2 * geometry.band_height_m
     cx_px = 0.5 * (bgr.shape[1] - 1)
     d = fy_px * white_m / max(rows.white_px, 1e-3) + geometry.radius_m
     half = rows.white_px * geometry.radius_m / white_m * (1.0 - geometry.radius_m / d)
+    both = cut_left and cut_right
+    edge_r = _limb_edge(bgr, c, gains, geometry, rows, half, True) if both or not cut_right else None
+    edge_l = _limb_edge(bgr, c, gains, geometry, rows, half, False) if both or not cut_left else None
+    if edge_r is not None and edge_l is not None:  # both natural: the outline's centre is their midpoint
+        if abs((edge_r - edge_l) / max(2 * half, 1e-6) - 1.0) > WHOLE_WIDTH:
+            return None
+        x = 0.5 * (edge_l + edge_r)
+    elif edge_r is not None or edge_l is not None:
+        right = edge_r is not None
+        x = outline_centre(edge_r if right else edge_l, right, cx_px, fy_px, rows.white_px, geometry)
+    else:
+        return None
+    if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
+        return None
+    return x, LIMB_SIGMA_X_PX
+
+
+def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGeometry, rows: Rows,
+               half: float, right: bool) -> Optional[float]:
+    """The column of the candidate's right (``right``) or left limb from both bands' limbs, or ``None``."""
+    white_m = geometry.height_m - 2 * geometry.band_height_m
+    band_px = rows.white_px * geometry.band_height_m / white_m
+    rx, _, rw, _ = c.red_bbox_px
     reach = round(2 * half) + 4
     edges = []
     for y_c, is_red in ((rows.red_y_px, True), (rows.blue_y_px, False)):
         if c.hidden_band == ("red" if is_red else "blue"):  # partly hidden (its robot's mast): its limb may be the mast
             continue
         y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
-        x0, x1 = (rx - 4, rx + rw + reach) if cut_left else (rx - reach, rx + rw + 4)
+        x0, x1 = (rx - 4, rx + rw + reach) if right else (rx - reach, rx + rw + 4)
         tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=thin_step(y1 - y0))
         er, eb = excess(tile, gains)
         lin_sum = np.maximum(linear_table()[tile].sum(axis=2), 1e-3)
-        q = ((er if is_red else eb) / lin_sum).mean(axis=0)  # chromaticity: shading does not move it
+        ex = er if is_red else eb
+        q = (ex / lin_sum).mean(axis=0)  # chromaticity: shading does not move it
         n = len(q)
         if n < 4:
             continue
-        if cut_left:  # the right limb is natural: start inside, run right
+        if right:  # start inside, run right
             core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
         else:
             core = max(0, min(n - 1, int(rx - ox) + int(half)))
         level = median(q[max(0, core - 2) : core + 3])
-        edges.append(ox + limb(q, core, n - 1 if cut_left else 0, level))
+        mix = (ex.mean(axis=0), lin_sum.mean(axis=0))  # the coverage from the mixture (edges.limb)
+        edges.append(ox + limb(q, core, n - 1 if right else 0, level, mix))
     edges = [e for e in edges if math.isfinite(e)]
     if not edges:
         return None
     if len(edges) == 2 and abs(edges[0] - edges[1]) <= LIMB_AGREE_PX:
-        edge = 0.5 * (edges[0] + edges[1])
-    else:
-        edge = min(edges) if cut_left else max(edges)
-    x = outline_centre(edge, cut_left, cx_px, fy_px, rows.white_px, geometry)
-    if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
-        return None
-    return x, LIMB_SIGMA_X_PX
+        return 0.5 * (edges[0] + edges[1])
+    return min(edges) if right else max(edges)
 
 
 def outline_centre(

@@ -1,0 +1,107 @@
+"""Limbs of landmarks cut at a side (core/limbs.py, core/edges.limb with the chromaticity mixture)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rangebearing.core.edges import limb
+from rangebearing.core.limbs import measure_columns, outline_centre
+from rangebearing.core.measure import Rows
+from rangebearing.core.structure import Candidate
+from rangebearing.core.types import LandmarkGeometry
+
+GEOMETRY = LandmarkGeometry()
+F_PX = 634.0
+
+
+def _mixed(n, edge, band_e, band_s, bg_e, bg_s, blur=None):
+    """Column profiles (excess, sum) of a band up to sub-pixel column ``edge`` over a background, mixed by
+    coverage in linear light, then blurred alike (``blur``: a symmetric kernel), and their ratio."""
+    cols = np.arange(n, dtype=np.float64)
+    cover = np.clip(edge - (cols - 0.5), 0.0, 1.0)
+    e = cover * band_e + (1 - cover) * bg_e
+    s = cover * band_s + (1 - cover) * bg_s
+    if blur is not None:
+        e, s = (np.convolve(np.pad(v, len(blur) // 2, mode="edge"), blur, "valid") for v in (e, s))
+    return e / s, e, s
+
+
+@pytest.mark.parametrize("edge", [20.0, 20.4])
+@pytest.mark.parametrize("blur", [None, np.array([0.25, 0.5, 0.25])])
+def test_a_limb_darker_than_a_bright_background_is_found_where_it_is(edge, blur):
+    # a cylinder's band darkens towards its limb (shading ~ cos): 0.5 of its sum far inside, 0.05 at the limb,
+    # against a bright grey wall (sum 1.5); the band's chromaticity is 0.6 everywhere, the wall's 0
+    n = 40
+    x = np.arange(n, dtype=np.float64)
+    band_s = 0.05 + 0.45 * np.clip((edge - x) / edge, 0.0, 1.0)
+    q, e, s = _mixed(n, edge, 0.6 * band_s, band_s, 0.0, 1.5, blur)
+    # blurred, the next columns' chromaticity is still a trace above the wall's: a few thousandths of a pixel
+    assert limb(q, 5, n - 1, 0.6, (e, s)) == pytest.approx(edge, abs=1e-6 if blur is None else 0.01)
+    # the chromaticity alone is no coverage mix: the bright wall dominates a mixed column, the edge moves in
+    assert limb(q, 5, n - 1, 0.6) < edge - 0.3
+
+
+def test_a_limb_with_the_mixture_going_left_is_the_mirror_image():
+    q, e, s = _mixed(40, 20.3, 0.06, 0.1, 0.02, 1.2)
+    mirror = [v[::-1].copy() for v in (q, e, s)]
+    assert limb(mirror[0], 34, 0, 0.6, (mirror[1], mirror[2])) == pytest.approx(39 - 20.3, abs=1e-6)
+
+
+def _frame(x0, x1, front=None):
+    """A crisp landmark (red rows 20-35, white 35-75, blue 75-90) from sub-pixel column ``x0`` to ``x1``
+    over a grey wall; ``front``: ``(column, colour)``, something nearer hiding every column left of it
+    (``"landmark"``: a nearer landmark's bands and body, the same colours row for row)."""
+    w = 160
+    cols = np.arange(w, dtype=np.float64)
+    cover = np.clip(np.minimum(x1 - (cols - 0.5), (cols + 0.5) - x0), 0.0, 1.0)
+    lin = np.full((120, w, 3), 0.30)
+    for (r0, r1), rgb in (((20, 35), (0.70, 0.07, 0.06)), ((35, 75), (0.85,) * 3), ((75, 90), (0.06, 0.12, 0.65))):
+        lin[r0:r1] = cover[:, None] * np.array(rgb) + (1 - cover[:, None]) * lin[r0:r1]
+        if front is not None and front[1] == "landmark":
+            lin[r0:r1, : front[0]] = rgb
+    if front is not None and front[1] != "landmark":
+        lin[:, : front[0]] = front[1]
+    return np.round(255.0 * lin[..., ::-1] ** (1 / 2.2)).astype(np.uint8)
+
+
+def _cut_both(x0, x1, visible):
+    return Candidate((x0, 20, x1 - x0, 15), (x0, 76, x1 - x0, 15), 40.0, False, False, True, True, visible)
+
+
+ROWS = Rows(27.5, 82.5, 40.0, 0.1, False, False)
+
+
+def _centre(limb_px, right):
+    return outline_centre(limb_px, right, 0.5 * (160 - 1), F_PX, ROWS.white_px, GEOMETRY)
+
+
+def test_a_partly_hidden_landmark_cut_on_both_sides_is_placed_from_the_side_that_falls_like_a_limb():
+    # a nearer landmark in front hides everything left of column 50: its bands run on into this one's, so
+    # only the right side (a limb at 74.3 before the wall) falls off; the moments would sit ~5 px left
+    img = _frame(40.3, 74.3, (50, "landmark"))
+    x, sigma = measure_columns(img, _cut_both(50, 74, 0.7), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(74.3, True), abs=0.05)
+    assert sigma > 0
+
+
+def test_both_sides_falling_a_whole_outline_apart_place_it_at_their_midpoint():
+    half = ROWS.white_px * GEOMETRY.radius_m / (GEOMETRY.height_m - 2 * GEOMETRY.band_height_m)
+    half *= 1.0 - GEOMETRY.radius_m / (F_PX * 0.04 / ROWS.white_px + GEOMETRY.radius_m)
+    x0 = 40.2
+    img = _frame(x0, x0 + 2 * half)
+    x, _ = measure_columns(img, _cut_both(41, 74, 0.9), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(x0 + half, abs=0.05)
+
+
+def test_a_side_hidden_by_something_of_another_colour_leaves_the_side_unknown():
+    # a grey-green part in front left of column 50: both sides fall off, 24 px apart, not a whole outline
+    img = _frame(40.3, 74.3, (50, (0.2, 0.35, 0.2)))
+    assert measure_columns(img, _cut_both(50, 74, 0.7), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS) is None
+
+
+def test_a_landmark_seen_whole_but_marked_cut_on_both_sides_keeps_its_moments():
+    img = _frame(40.3, 74.3)
+    c = _cut_both(40, 74, 1.0)
+    assert measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS) is None
+    assert math.isfinite(c.visible)
