@@ -271,6 +271,7 @@ def luma_inner(p: np.ndarray, edge: float, down: bool, band_px: float) -> Option
     return luma_edge(p, edge, down, band_px, True)
 
 
+CHROMA_SPREAD_PX = 2  # a limb's chromaticity falling over more columns than this (80 % to 20 %): chroma blurred
 LIMB_BLUR_PX = 3  # columns a limb's edge may be spread over (optics, sensor, the ½-resolution search)
 
 
@@ -293,7 +294,11 @@ def limb(profile: np.ndarray, core: int, end: int, level: float,
     background brighter than the limb pulled the edge inwards (bearing 0.05-0.15° towards the
     inside on touching/crowd landmarks placed from one limb). With ``mix`` each column's
     coverage is solved from that mixture, knowing the band's chromaticity (``level``) and the
-    background's brightness and chromaticity, whatever the band's own brightness there.
+    background's brightness and chromaticity, whatever the band's own brightness there. That
+    takes the chroma and the luma blurred alike: where the chromaticity takes more than
+    ``CHROMA_SPREAD_PX`` columns from 80 % to 20 % of its step (a camera's 4:2:0 chroma or colour
+    denoise spreads it over 5-8 px while the luma stays sharp) the mixture does not hold and the
+    chromaticity's own two-level edge is taken.
     """
     step = 1 if end > core else -1
     seg = profile[core : end + 1] if step > 0 else profile[core : (end - 1 if end > 0 else None) : -1]
@@ -306,7 +311,8 @@ def limb(profile: np.ndarray, core: int, end: int, level: float,
     bg = median(seg[k + 1 : k + 1 + BG_ROWS]) if k + 1 < len(seg) else float(seg[k])
     if not level - bg > MERGE_CONTRAST * abs(level):
         return float("nan")
-    if mix is None:
+    rel = (seg[start : min(len(seg), stop + 2)] - bg) / (level - bg)
+    if mix is None or np.count_nonzero((rel > 0.2) & (rel < 0.8)) > CHROMA_SPREAD_PX:
         edge = edge_down(seg, start, stop, level, bg)  # columns counted outwards from ``core``
     else:
         edge = _mixed_edge(*(_outwards(m, core, end, step) for m in mix), start, stop, k, level, bg)

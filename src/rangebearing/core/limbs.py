@@ -31,6 +31,7 @@ OUTLINE_ITERATIONS = 4  # fixed-point steps for the axis angle (each gains about
 LIMB_AGREE_PX = 1.5  # the two bands' limbs of one cylinder agree within this; farther apart, one was widened
 MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
 HIDDEN_BELOW = 0.95  # a candidate cut on both sides seen narrower than this share of its silhouette is partly hidden
+RUN_END_PX, RUN_END_SHARE = 3.0, 0.1  # a limb this far (px + share of outline) from its run's end: not its own
 WHOLE_WIDTH = 0.1  # two limbs this close (relative) to a whole outline apart are both natural
 FRAME_EDGE_PX = 2  # a run starting this close to the frame's edge (½-resolution columns) may be cut by it
 
@@ -86,7 +87,9 @@ def measure_columns(
     background like a limb (the other runs on into a same-coloured band in front),
     from that one; where both do and they lie a whole outline apart, from their
     midpoint. Where both fall off closer together (something of another colour in
-    front on one side) the side is not known: the moments stand.
+    front on one side) the side is not known: the moments stand. A limb found farther than
+    ``RUN_END_PX`` + ``RUN_END_SHARE`` of the outline from the end of the run the structure
+    search saw on its side is not taken (a background of the band's colour carried the band on).
     """
     cut_left, cut_right = cut_sides(c, bgr.shape[1])
     if not (cut_left or cut_right):
@@ -101,6 +104,10 @@ def measure_columns(
     both = cut_left and cut_right
     edge_r = _limb_edge(bgr, c, gains, geometry, rows, half, True) if both or not cut_right else None
     edge_l = _limb_edge(bgr, c, gains, geometry, rows, half, False) if both or not cut_left else None
+    if both:  # a side's limb, where it has one, ends the run the structure search saw there
+        tol = RUN_END_PX + RUN_END_SHARE * 2 * half
+        edge_r = edge_r if edge_r is not None and abs(edge_r - (rx + rw)) <= tol else None
+        edge_l = edge_l if edge_l is not None and abs(edge_l - rx) <= tol else None
     if edge_r is not None and edge_l is not None:  # both natural: the outline's centre is their midpoint
         if abs((edge_r - edge_l) / max(2 * half, 1e-6) - 1.0) > WHOLE_WIDTH:
             return None
