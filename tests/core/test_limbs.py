@@ -105,3 +105,14 @@ def test_a_landmark_seen_whole_but_marked_cut_on_both_sides_keeps_its_moments():
     c = _cut_both(40, 74, 1.0)
     assert measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS) is None
     assert math.isfinite(c.visible)
+
+
+def test_where_the_chroma_is_blurred_more_than_the_luma_the_chromaticity_edge_stands():
+    # 4:2:0 chroma / colour denoise: the band's excess spread over ~7 columns, its brightness sharp (a grey
+    # background about as bright as the band); the mixture (one blur for both) does not hold there, so the
+    # limb is the chromaticity's own two-level edge
+    q, e, s = _mixed(40, 20.3, 0.18, 0.3, 0.0, 0.35)
+    e = np.convolve(np.pad(e, 3, mode="edge"), np.full(7, 1 / 7), "valid")
+    q = e / s
+    level = float(np.median(q[5:10]))
+    assert limb(q, 7, 39, level, (e, s)) == limb(q, 7, 39, level)
