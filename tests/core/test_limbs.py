@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from rangebearing.core.edges import limb
+from rangebearing.core.limb_edge import limb
 from rangebearing.core.limbs import measure_columns, outline_centre
 from rangebearing.core.measure import Rows
 from rangebearing.core.structure import Candidate

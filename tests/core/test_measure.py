@@ -8,7 +8,7 @@ import pytest
 
 from rangebearing import Pipeline, load_config
 from rangebearing.core.band_seed import seeded_band
-from rangebearing.core.edges import limb
+from rangebearing.core.limb_edge import limb
 from rangebearing.core.measure import measure_rows, outline_centre
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry

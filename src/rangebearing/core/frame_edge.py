@@ -15,7 +15,8 @@ from typing import Optional, Tuple
 import numpy as np
 
 from .color import Gains
-from .edges import excess, limb, linear_table
+from .edges import excess, linear_table
+from .limb_edge import limb
 from .limbs import FRAME_EDGE_PX, _tile, thin_step
 from .stats import median
 from .structure import MIN_VISIBLE, Candidate

@@ -16,7 +16,8 @@ from typing import TYPE_CHECKING, Optional, Tuple
 import numpy as np
 
 from .color import Gains
-from .edges import excess, limb, linear_table
+from .edges import excess, linear_table
+from .limb_edge import limb
 from .refine import Pyramid
 from .stats import median
 from .structure import Candidate
