@@ -149,3 +149,58 @@ def test_a_neighbour_on_one_side_excuses_only_its_own_columns():
     beside_grey[:, X1 + 2 :] = frame()[:, X1 + 2 :]  # beyond the right side the wall is grey
     assert rejection(beside_grey, c, GEOMETRY, others=[c, sliver]) is None
     assert "stripes" in rejection(striped_frame(), c, GEOMETRY, others=[c, sliver])
+
+
+def wide(img, width=200, at=80):
+    """``img`` (the 80-px frames above) with its columns 0-80 placed at ``at`` in a frame ``width`` wide,
+    its first and last columns repeated outwards (a background that runs on)."""
+    out = np.repeat(img[:, :1], width, axis=1)
+    out[:, at + 80 :] = img[:, -1:]
+    out[:, at : at + 80] = img
+    return out
+
+
+def shifted(c, dx):
+    return dataclasses.replace(c, red_xy_px=(c.red_xy_px[0] + dx, c.red_xy_px[1]),
+                               blue_xy_px=(c.blue_xy_px[0] + dx, c.blue_xy_px[1]),
+                               red_bbox_px=(c.red_bbox_px[0] + dx, *c.red_bbox_px[1:]),
+                               blue_bbox_px=(c.blue_bbox_px[0] + dx, *c.blue_bbox_px[1:]))
+
+
+MAST = (0.03, 0.03, 0.035)  # a robot's dark mast and camera board
+
+
+def masted(img, cols):
+    """``img`` with a dark mast over the columns ``cols`` from the top of the red band down."""
+    out = img.copy()
+    out[RED_ROWS[0] :, cols[0] : cols[1]] = np.round(255.0 * np.array(MAST[::-1]) ** (1 / 2.2)).astype(np.uint8)
+    return out
+
+
+def cut(c):
+    """``c`` with its run cut on both sides (ended by something other than its limbs: here, masts)."""
+    return dataclasses.replace(c, candidate=dataclasses.replace(c.candidate, cut_left=True, cut_right=True))
+
+
+def test_stripes_running_on_beyond_a_mast_beside_it_are_still_stripes():
+    c = cut(shifted(found(), 80))  # the landmark's columns 100-140 in a frame 200 px wide
+    stripes = wide(striped_frame())
+    # a mast right beside each side (0.15-0.6 of the width out) hides the stripes there, not beyond
+    beside = masted(masted(stripes, (80, 96)), (144, 160))
+    assert "stripes" in rejection(beside, c, GEOMETRY)
+    # a run that ends at its limbs is judged right beside them (what lies there is what is beside it)
+    assert rejection(beside, shifted(found(), 80), GEOMETRY) is None
+    # a real landmark between two masts before a grey wall: nothing runs on
+    assert rejection(masted(masted(wide(frame()), (80, 96)), (144, 160)), c, GEOMETRY) is None
+    # ... nor before a skirting board that ends at the masts (grey wall beyond them)
+    ends = beside.copy()
+    ends[:, :80], ends[:, 160:] = wide(frame())[:, :80], wide(frame())[:, 160:]
+    assert rejection(ends, c, GEOMETRY) is None
+
+
+def test_a_neighbour_beyond_a_mast_is_no_stripe():
+    c = cut(shifted(found(), 80))
+    stripes = masted(wide(striped_frame()), (144, 160))
+    neighbour = shifted(c, 62)  # another candidate at the stripes' rows beyond the mast (columns 162-202)
+    assert "stripes" in rejection(stripes, c, GEOMETRY)  # the stripes beyond the mast
+    assert rejection(stripes, c, GEOMETRY, others=[c, neighbour]) is None  # a neighbour's own bands and body

@@ -46,7 +46,9 @@ the checks here ask for:
   run on, unchanged, beyond its sides is no landmark. Columns where another
   candidate stands are not looked at (touching neighbours show their own bands
   and bodies), but the rest of that side is: a real landmark right beside a
-  skirting board excuses none of the board.
+  skirting board excuses none of the board. Nor does a robot's mast and camera
+  board in front of the stripes right beside the false one (what often ends
+  it): the stripes run on when they show again a little farther out.
 
 Levels are taken in linear light over the middle three fifths of the
 candidate's visible columns (limbs darken and mix with the background); of
@@ -78,6 +80,7 @@ HEIGHT_MIN_TOL_M = 0.03
 PITCH_WOBBLE = 0.0087
 # stripes: the colour beside the candidate, 0.15-0.6 of its width out, matches its own within this (log, per channel)
 SIDE_REACH = (0.15, 0.6)
+SIDE_WINDOWS, SIDE_STEP = 3, 0.45  # ... or in a window as wide this much farther out, up to 1.5 widths beyond a side
 SAME_COLOUR_LOG = 0.25
 
 
@@ -122,27 +125,59 @@ def _free(side: Tuple[float, float], boxes: Sequence[Tuple[float, float]]) -> Op
     return best if best[1] - best[0] >= max(1.0, (side[1] - side[0]) / 3) else None
 
 
+def _sides(c: BandCentroids, boxes: Sequence[Tuple[float, float]], frame_w: int) -> List[List[Tuple[float, float]]]:
+    """Per side of ``c`` judged (its nearest window free), the free column spans of its windows, nearest first
+    (farther windows only on a side where its run was cut: one that ends at its limb shows what lies beside it)."""
+    x, _, w, _ = c.bbox_px
+    cand = c.candidate
+    out = []
+    for sign, cut in ((-1.0, cand is not None and cand.cut_left), (1.0, cand is not None and cand.cut_right)):
+        found: List[Tuple[float, float]] = []
+        for k in range(SIDE_WINDOWS if cut else 1):
+            near, far = SIDE_REACH[0] + k * SIDE_STEP, SIDE_REACH[1] + k * SIDE_STEP
+            span = (x - far * w, x - near * w) if sign < 0 else (x + w + near * w, x + w + far * w)
+            if k and (span[0] < 0 or span[1] > frame_w - 1):  # a farther window past the frame's edge: none
+                break
+            free = _free(span, boxes)
+            if free:
+                found.append(free)
+            elif not k:  # a neighbour right beside it: the side is not judged (it shows the neighbour)
+                break
+        if found:
+            out.append(found)
+    return out
+
+
 def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, float]],
             others: Sequence[BandCentroids] = ()) -> bool:
     """Whether the colours of ``layers`` (row spans) run on unchanged beyond the sides of ``c``.
 
     Columns where another candidate stands are not looked at (a touching
-    neighbour shows its own bands and body there): a side is judged on what
-    is left of it, and a side that a neighbour covers (two thirds or more)
-    not at all. Stripes run on beyond every side judged, and at least one is.
+    neighbour shows its own bands and body there): a side is judged on what is
+    left of its window 0.15-0.6 of the width out, and a side whose window a
+    neighbour covers (two thirds or more) not at all. The layers run on beyond a
+    judged side when they show unchanged in that window or, where the run was
+    cut on that side (it ends at something other than a limb), in one of the
+    ``SIDE_WINDOWS - 1`` as wide stepping outwards (0.45 of the width each, on
+    what no neighbour covers): a thin thing in front of the stripes right beside
+    it (a robot's mast and camera board, which often end the false "landmark")
+    does not hide that they go on. Stripes run on beyond every side judged, and
+    at least one is.
     """
-    x, _, w, _ = c.bbox_px
-    near, far = SIDE_REACH[0] * w, SIDE_REACH[1] * w
     boxes = [(b[0] - 1.0, b[0] + b[2] + 1.0) for b in (o.bbox_px for o in others if o is not c)]  # a property: once
-    sides = [s for s in (_free((x - far, x - near), boxes), _free((x + w + near, x + w + far), boxes)) if s]
+    sides = _sides(c, boxes, bgr.shape[1])
     if not sides:
         return False
+    x, _, w, _ = c.bbox_px
+    own: dict = {}  # each layer's own colour, measured when first needed
+
+    def same(rows: Tuple[float, float], span: Tuple[float, float]) -> bool:
+        if rows not in own:
+            own[rows] = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
+        return _same(own[rows], _colour(bgr, rows, span))
+
     # body first: beside most real landmarks it is the background, and one differing layer ends the test
-    for rows in reversed(layers):
-        own = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
-        if not all(_same(own, _colour(bgr, rows, side)) for side in sides):
-            return False
-    return True
+    return all(any(all(same(rows, span) for rows in reversed(layers)) for span in windows) for windows in sides)
 
 
 def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
