@@ -219,6 +219,7 @@ def aligned_truth(frames_path: Union[str, Path], truth_path: Union[str, Path]) -
 
         truth = key_by_position(truth, frame_times_ns(path))
     if path.is_dir():
+        count_recorded(path)  # an empty directory is named as such, not as truth that matches no frame
         names = [p.name for p in list_images(path)]
     else:
         n = count_recorded(path)

@@ -11,9 +11,10 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from ..allocator import keep_freed_buffers
 from ..config import Config, check
+from ..daemon.capture import SourceUnusable
 from ..daemon.loop import Daemon
 from ..daemon.sdnotify import Notifier
-from ..errors import ConfigError
+from ..errors import CameraError, ConfigError, SourceError
 from ..net.fanout import FanOut, Shared
 from ..net.protocol import decode_reading
 from ..net.publisher import Publisher, UdpPublisher
@@ -68,7 +69,12 @@ def recorder_for(args: argparse.Namespace, cfg: Config) -> Optional[Any]:
 
 
 def source_opener(cfg: Config, sleep: Callable[[float], object]) -> FrameSource:
-    return open_source(cfg.source, cfg.camera, sleep=sleep, in_place=True)  # the loop is done with each frame
+    try:
+        return open_source(cfg.source, cfg.camera, sleep=sleep, in_place=True)  # the loop is done with each frame
+    except SourceError as exc:  # a recording that is missing or unreadable stays so: no minute of retries
+        if cfg.source.kind in ("recorded", "synthetic") and not isinstance(exc, CameraError):
+            raise SourceUnusable(str(exc)) from None
+        raise
 
 
 def publisher_for(cfg: Config) -> UdpPublisher:

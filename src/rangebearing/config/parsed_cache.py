@@ -25,6 +25,7 @@ from typing import Any, Callable, Optional, Union
 from .. import _compat
 
 VERSION = 1  # of the stored form
+READ_LIMIT = 64 * 1024  # yaml_safe.MAX_BYTES (not imported: that imports PyYAML)
 
 
 class _NotPlain(Exception):
@@ -41,10 +42,11 @@ def parsed(path: Union[str, Path], parse: Callable[[Union[str, Path]], Any]) -> 
     """``parse(path)``, or the data a parse of the same bytes gave before."""
     where = cache_dir()
     try:
-        raw = Path(path).read_bytes()
+        with open(path, "rb") as f:  # bounded: /dev/zero or a 2 GB file is the parser's to refuse, unread
+            raw: Optional[bytes] = f.read(READ_LIMIT + 1)
     except (OSError, ValueError):  # unreadable, or a NUL in the path: the parser words it
         raw = None
-    if where is None or raw is None:
+    if where is None or raw is None or len(raw) > READ_LIMIT:
         return parse(path)  # it words a file it cannot read
     entry = where / f"config-{_key(raw)}.json"
     try:

@@ -188,11 +188,13 @@ def load_yaml(path: Union[str, Path], c_parser: Optional[bool] = None) -> Any:
     ------
     ConfigError
         Naming the file, with a line number where there is one: unreadable, too
-        big, not UTF-8, not YAML, nested deeper than :data:`MAX_DEPTH`, more than
+        big, empty, not UTF-8, not YAML, nested deeper than :data:`MAX_DEPTH`, more than
         :data:`MAX_VALUES` values once aliases are expanded, or duplicate keys.
     """
     source = str(path)
     text = read_text(path)
+    if not text.strip():  # a save cut short (a full disk) or the wrong file: never "all defaults" by accident
+        raise ConfigError(["the file is empty (write {} in it to run on the defaults)"], source)
     if _CLoader is not None and c_parser is not False:
         try:
             return _parse(text, source, _CLoader)
@@ -216,6 +218,8 @@ def _parse(text: str, source: str, loader_class: type) -> Any:
             raise ConfigError([f"more than {MAX_VALUES:,} values once aliases (*name) are expanded: "
                                "an alias bomb? write the values out"], source)
         data = loader.construct_document(node)
+    except ConfigError:
+        raise  # already says what is wrong (an alias bomb): not wrapped in "not valid YAML"
     except yaml.MarkedYAMLError as exc:
         raise ConfigError([cut(f"not valid YAML: {_where(exc)}{exc.problem or exc.context}", 300)], source) from None
     except yaml.YAMLError as exc:  # a ReaderError (a control character) has no mark attributes

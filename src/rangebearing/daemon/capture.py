@@ -41,6 +41,10 @@ class CameraGone(CameraError):
     """No frame for the whole capture budget (or no camera within the start budget)."""
 
 
+class SourceUnusable(SourceError):
+    """A source that waiting cannot mend (a recording that is missing, empty or not a video): never retried."""
+
+
 class _Reader:
     """One source's reads, run in a thread of their own (unless the source says its reads cannot wedge)."""
 
@@ -153,6 +157,8 @@ class CaptureGuard:
         while not self._stop.is_set():
             try:
                 source = opener(sleep)
+            except SourceUnusable:
+                raise
             except SourceError as exc:
                 left = deadline - self._clock()
                 if isinstance(exc, CameraLibraryError):  # not installed: no retry brings it
@@ -182,7 +188,7 @@ class CaptureGuard:
         try:
             if self.open(opener, budget_s=budget_s):
                 return True
-        except CameraGone as exc:
+        except (CameraGone, SourceUnusable) as exc:
             log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
         self.open(old, budget_s=old_budget_s)
         return False

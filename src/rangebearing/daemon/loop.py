@@ -8,8 +8,8 @@ lets a network fault through, and on SIGHUP swaps in the config that the injecte
 frames; a reload can never end the daemon. Camera faults are ridden out by :mod:`.capture`.
 
 Exit status: 0 for the end of a recording or a requested stop (SIGTERM at any moment, camera back-off
-included), 1 when the camera is gone past its budget, 2 when the frames cannot fit the configuration (another
-aspect ratio).
+included), 1 when the camera is gone past its budget, 2 when the first frame cannot fit the configuration (another
+aspect ratio; a frame of another size after good ones is skipped and counted).
 """
 
 from __future__ import annotations
@@ -185,10 +185,10 @@ class Daemon(Reloading):
                 t_unix = _unix_time(frame, t1)
                 payload = encode_fitting(pub.robot_id, seq, t_unix, result.landmarks, self.stats.fps,
                                          self.dropped)  # always one packet: the nearest landmarks if not all fit
-            except FrameShapeError:
-                raise
             except (FrameError, ProtocolError) as exc:  # a bad frame, or a reading that cannot be encoded
-                self._bad_frame(exc)
+                if isinstance(exc, FrameShapeError) and not self.house.ready:
+                    raise  # the first frame already cannot fit: every frame would fail the same way (status 2)
+                self._bad_frame(exc)  # after good frames (a recording of mixed sizes): that frame is skipped
                 continue
             self._publisher.send(payload)  # type: ignore[union-attr]
             t2, seq = clock(), seq + 1

@@ -214,7 +214,7 @@ def align_truth(
     if unmatched:
         shown = ", ".join(repr(n) for n in unmatched[:10])
         shown += f" and {len(unmatched) - 10} more" if len(unmatched) > 10 else ""
-        example = ", ".join(repr(f) for f in list(frames)[:3])
+        example = ", ".join(repr(f) for f in list(frames)[:3]) or "nothing: the recording holds no frames"
         raise TruthError(f"{source}: {len(unmatched)} of {len(truth)} truth frame(s) match no frame: {shown} "
                          f"(the frames are named like {example}; a video's frames by their 0-based index)")
     return out

@@ -77,6 +77,7 @@ class BackgroundRecorder:
         self._queue: queue.Queue[Any] = queue.Queue(queue_items)
         # The first file is opened here so that a bad path fails in the caller.
         self._recorder: Optional[McapRecorder] = self._open(time.time_ns())
+        self._abandoned = False
         self._thread = threading.Thread(target=self._run, name="mcap-writer", daemon=True)
         self._thread.start()
 
@@ -120,7 +121,7 @@ class BackgroundRecorder:
                 continue
             try:
                 self._write(item)
-            except (RecordingError, OSError) as exc:
+            except Exception as exc:  # deliberately broad: a writer that dies leaves close() and the queue stuck
                 self._fail(exc)
         self._finish()
 
@@ -169,10 +170,21 @@ class BackgroundRecorder:
                 self._fail(exc)
 
     def close(self, timeout_s: float = 10.0) -> None:
-        """Write what is queued, finish the file and stop the thread. Safe to call twice."""
-        if self._thread.is_alive():
-            self._queue.put(_STOP)  # blocks only while the queue is full: the writer is draining it
-            self._thread.join(timeout_s)
+        """Write what is queued, finish the file and stop the thread, within ``timeout_s``. Safe to call twice.
+
+        A writer stuck in a write (a USB stick pulled, an NFS server gone) never
+        holds the caller (a daemon asked to stop) past ``timeout_s``: the file is
+        then left unfinished (a reader reads it up to its last complete chunk).
+        """
+        deadline = time.monotonic() + timeout_s
+        if self._thread.is_alive() and not self._abandoned:
+            with contextlib.suppress(queue.Full):
+                self._queue.put(_STOP, timeout=timeout_s)  # waits only while the queue is full
+            self._thread.join(max(0.0, deadline - time.monotonic()))
+        if self._thread.is_alive() and not self._abandoned:
+            self._abandoned = True  # a second close() does not wait again
+            self._log.warning("recording to %s not finished within %g s: left as it is (the writer is stuck)",
+                              self.path, timeout_s)
 
     def __enter__(self) -> BackgroundRecorder:
         return self

@@ -8,11 +8,11 @@ where an index-based reader would refuse a file without a footer.
 
 from __future__ import annotations
 
+import logging
 import os
 import struct
 from typing import Any, Iterable, Iterator, List, Optional, Tuple, Union
 
-import cv2
 import numpy as np
 
 from .._compat import frozen
@@ -28,6 +28,7 @@ from .mcap_format import (
 )
 
 PathLike = Union[str, "os.PathLike[str]"]
+log = logging.getLogger("rangebearing.recording")
 MAGIC = b"\x89MCAP0\r\n"
 
 
@@ -77,8 +78,26 @@ def _stream_reader(f: Any) -> Any:
 
 
 def decode_image(img: ImageMessage) -> Optional[np.ndarray]:
-    """The stored PNG/JPEG as H×W×3 uint8 BGR, or ``None`` when it does not decode."""
-    return cv2.imdecode(np.frombuffer(img.data, np.uint8), cv2.IMREAD_COLOR)
+    """The stored PNG/JPEG as H×W×3 uint8 BGR, or ``None`` when it does not decode (or claims too many pixels)."""
+    from ..sources.image_bytes import decode
+
+    return decode(img.data)
+
+
+def _damaged(path: str, offset: int, exc: BaseException) -> None:
+    """Say once per file (a looping replay reads it again and again) where its readable part ends."""
+    try:
+        key = (path, os.stat(path).st_size, os.stat(path).st_mtime_ns)
+    except OSError:
+        key = (path, -1, -1)
+    if key in _WARNED:
+        return
+    _WARNED.add(key)
+    what = str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__
+    log.warning("%s: cut short or damaged near byte %d (%s): nothing after it can be read", path, offset, what)
+
+
+_WARNED: set = set()
 
 
 class McapRecording:
@@ -108,8 +127,9 @@ class McapRecording:
                     record = next(records)
                 except StopIteration:
                     return
-                except (mcap_error, struct.error, ValueError, EOFError, MemoryError):
+                except (mcap_error, struct.error, ValueError, EOFError, MemoryError, OverflowError) as exc:
                     self.truncated = True  # the rest of the file is cut short or damaged
+                    _damaged(self.path, f.tell(), exc)
                     return
                 if isinstance(record, channel_type):
                     channels[record.id] = record.topic

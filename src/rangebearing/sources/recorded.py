@@ -13,6 +13,7 @@ from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
 from .clip_store import ClipStore
+from .image_bytes import decode_file
 from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
 from .pacing import Pacer
 from .video_frames import END, EndOfVideo, VideoFrames, open_video
@@ -31,15 +32,8 @@ def list_images(directory: Path) -> List[Path]:
 
 
 def _decode(path: Path) -> Optional[np.ndarray]:
-    # imdecode of the raw bytes rather than imread: works with any file name
-    # and returns None (not an exception) for a corrupt file.
-    try:
-        data = np.fromfile(str(path), dtype=np.uint8)
-    except OSError:
-        return None
-    if data.size == 0:
-        return None
-    return cv2.imdecode(data, cv2.IMREAD_COLOR)
+    # the raw bytes decoded (any file name; None, not an exception, for a corrupt, huge or unreadable file)
+    return decode_file(path)
 
 
 def _check_path(path: PathLike) -> Path:
@@ -50,6 +44,8 @@ def _check_path(path: PathLike) -> Path:
         raise SourceError(f"{p}: no such file or directory")
     if p.is_dir() and not list_images(p):
         raise SourceError(f"{p}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
+    if p.suffix.lower() == ".mcap" and p.is_file() and not is_mcap_file(p):
+        raise SourceError(f"{p}: not an MCAP file (no MCAP magic at its start: empty, or another format)")
     return p
 
 
