@@ -43,3 +43,33 @@ def test_a_signal_while_the_main_thread_holds_the_actions_lock_is_acted_on() -> 
 def test_the_old_handler_deadlocks_there_which_is_what_the_relay_prevents() -> None:
     with pytest.raises(subprocess.TimeoutExpired):
         subprocess.run([sys.executable, "-c", _CHILD, "handler"], capture_output=True, timeout=3)
+
+
+def test_an_action_that_raises_does_not_end_the_relay(caplog: pytest.LogCaptureFixture) -> None:
+    import os
+    import signal
+    import threading
+
+    from rangebearing import _signals
+
+    calls, second = [], threading.Event()
+
+    def flaky() -> None:  # e.g. a stop that races the loop closing its source
+        calls.append(1)
+        if len(calls) == 1:
+            raise AttributeError("'NoneType' object has no attribute 'done'")
+        second.set()
+
+    previous = signal.getsignal(signal.SIGUSR2)
+    try:
+        _signals.handle({signal.SIGUSR2: flaky})
+        os.kill(os.getpid(), signal.SIGUSR2)
+        for _ in range(600):  # until the relay ran the first one (it logs the failure)
+            if calls:
+                break
+            threading.Event().wait(0.1)
+        os.kill(os.getpid(), signal.SIGUSR2)
+        assert second.wait(60), "the relay thread died with the first action's exception"
+    finally:
+        signal.signal(signal.SIGUSR2, previous)
+    assert any("signal" in r.getMessage() and r.exc_info for r in caplog.records)

@@ -78,7 +78,16 @@ class Relay:
                 return
             for signum in dict.fromkeys(data):  # each signal once a batch, in order
                 if self._pending.pop(signum, False) and signum in self._actions:
-                    self._actions[signum]()
+                    try:
+                        self._actions[signum]()
+                    except Exception:  # an action's bug must not end the relay: later signals would be lost
+                        _log_failure(signum)
+
+
+def _log_failure(signum: int) -> None:
+    import logging  # here, in the relay thread (never in a handler); this module imports nothing heavy at start
+
+    logging.getLogger("rangebearing").exception("the action for signal %d failed", signum)
 
 
 _relay: Optional[Relay] = None

@@ -133,8 +133,9 @@ class CaptureGuard:
 
     def interrupt(self) -> None:
         """Wake a wait for a capture (called with the stop request, from a signal handler)."""
-        if self._reader is not None:
-            self._reader.done.set()
+        reader = self._reader  # read once: the loop's thread may close it (None) meanwhile (a source swap)
+        if reader is not None:
+            reader.done.set()
 
     # --- opening ----------------------------------------------------------------------
     def open(self, opener: Optional[Opener] = None, budget_s: Optional[float] = None) -> bool:
