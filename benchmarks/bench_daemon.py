@@ -36,6 +36,7 @@ import numpy as np
 from rangebearing import Config
 from rangebearing._compat import frozen
 from rangebearing.config import PublishConfig, SourceConfig, dump_config
+from rangebearing.daemon.loop import AUTO_SCAN_AFTER_SEND_FPS
 
 SETTLE_S = 0.5  # after the first loop of the recording (decoding it), before the CPU window opens
 
@@ -261,6 +262,13 @@ def bench_clip(n_frames: int = 60) -> Tuple[Config, List[np.ndarray]]:
     return clip.cfg, clip.frames
 
 
+def _mode(later: object, fps: float) -> str:
+    """How a row's daemon.scan_after_send reads: on, off, or auto with what it chose at this rate."""
+    if later == "auto":
+        return f"auto ({'on' if fps >= AUTO_SCAN_AFTER_SEND_FPS else 'off'})"
+    return "on" if later else "off"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """``python benchmarks/bench_daemon.py [--fps 30 90] [--seconds S] [--runs N]``: the daemon rows alone."""
     import argparse
@@ -270,8 +278,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, default=None, help="window per run (default 10 s at 30 fps, 5 s else)")
     p.add_argument("--runs", type=int, default=1, help="runs per frame rate")
     p.add_argument("--frames", type=int, default=60)
-    p.add_argument("--scan-after-send", choices=("off", "on", "both"), default="off",
-                   help="daemon.scan_after_send; both: alternate the two in each run (default off)")
+    p.add_argument("--scan-after-send", choices=("auto", "off", "on", "both"), default="auto",
+                   help="daemon.scan_after_send; both: alternate off and on in each run (default auto, the "
+                        "config's default: on at >= 60 fps)")
     p.add_argument("--first-start", action="store_true",
                    help="the package's cache off (parsed config, dataclass methods): a robot's very first start")
     p.add_argument("--no-bytecode", action="store_true",
@@ -281,7 +290,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {max(os.sched_getaffinity(0))})
     cfg, frames = bench_clip(args.frames)
-    modes = {"off": (False,), "on": (True,), "both": (False, True)}[args.scan_after_send]
+    modes = {"auto": ("auto",), "off": (False,), "on": (True,), "both": (False, True)}[args.scan_after_send]
     print("| fps | scan after send | bytecode | start-up s (CPU s) | datagrams / due | dropped | gaps | CPU % "
           "| CPU ms/frame | pipeline ms/frame (tracked) | rest ms/frame | p50 / p99 / max ms | RSS / peak MiB | load |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -291,9 +300,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             run_cfg = dataclasses.replace(cfg, daemon=dataclasses.replace(cfg.daemon, scan_after_send=later))
             d = daemon_run(run_cfg, frames, fps, seconds, bytecode=not args.no_bytecode, restart=not args.first_start)
             if d.error:
-                print(f"| {fps:g} | {'on' if later else 'off'} | failed: {d.error[:300]} |")
+                print(f"| {fps:g} | {_mode(later, fps)} | failed: {d.error[:300]} |")
                 continue
-            print(f"| {fps:g} | {'on' if later else 'off'} | {'yes' if d.bytecode else 'no'}"
+            print(f"| {fps:g} | {_mode(later, fps)} | {'yes' if d.bytecode else 'no'}"
                   f"{'' if d.restart else ', first start'} "
                   f"| {d.startup_s:.3f} ({d.startup_cpu_s:.3f}) "
                   f"| {d.received} / {d.frames_expected} | {d.dropped} | {d.seq_gaps} | {d.cpu_pct:.2f} "

@@ -41,3 +41,28 @@ def test_every_frame_is_sent_in_order_with_the_same_landmarks_and_ids(static_cli
     assert "scan" in s_on.stage_ms and "scan" not in s_off.stage_ms
     assert s_on.tracked_pct > s_off.tracked_pct  # the scans' frames were sent tracked
     assert s_on.bad_frames == s_off.bad_frames == 0
+
+
+def test_auto_scans_after_the_send_at_latency_bound_rates_only(tmp_path):
+    from rangebearing.config import Config, load_config
+    from rangebearing.daemon.loop import scans_after_send
+    from rangebearing.errors import ConfigError
+
+    assert Config().daemon.scan_after_send == "auto"
+    at = {fps: scans_after_send(dataclasses.replace(Config(), source=dataclasses.replace(Config().source, fps=fps)))
+          for fps in (0.0, 30.0, 59.0, 60.0, 90.0)}
+    assert at == {0.0: False, 30.0: False, 59.0: False, 60.0: True, 90.0: True}
+    forced = dataclasses.replace(Config(), daemon=dataclasses.replace(Config().daemon, scan_after_send=False),
+                                 source=dataclasses.replace(Config().source, fps=90.0))
+    assert scans_after_send(forced) is False
+    path = tmp_path / "c.yaml"
+    for text, value in (("auto", "auto"), ("true", True), ("false", False)):
+        path.write_text(f"daemon: {{scan_after_send: {text}}}\n")
+        assert load_config(path).daemon.scan_after_send == value
+    path.write_text("daemon: {scan_after_send: sometimes}\n")
+    try:
+        load_config(path)
+    except ConfigError as exc:
+        assert "daemon.scan_after_send: expected true, false or auto" in str(exc)
+    else:
+        raise AssertionError("'sometimes' was accepted")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import ipaddress
 import math
 import re
-from typing import Any, Callable, Dict, List, Mapping, Tuple
+from typing import Any, Callable, Dict, List, Mapping, Tuple, Union
 
 Check = Callable[[Any], Any]
 
@@ -85,6 +85,16 @@ def boolean(v: Any) -> bool:
     if not isinstance(v, bool):
         raise ValueError(f"expected true or false, got {show(v)}")
     return v
+
+
+def boolean_or(word: str) -> Check:
+    """true, false or ``word`` (e.g. ``auto``)."""
+    def check(v: Any) -> Union[bool, str]:
+        if not isinstance(v, bool) and v != word:
+            raise ValueError(f"expected true, false or {word}, got {show(v)}")
+        return v
+
+    return check
 
 
 def choice(*choices: str) -> Check:

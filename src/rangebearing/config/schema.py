@@ -9,7 +9,7 @@ publish, daemon) belong to the application shell.
 from __future__ import annotations
 
 import math
-from typing import Any, Dict, Tuple
+from typing import Any, Dict, Tuple, Union
 
 from .._compat import frozen
 from ..core.identity import IdentityParams
@@ -83,8 +83,9 @@ class DaemonConfig:
     view_port: int = 0  # the live web page (docs/view.md); 0 = off
     view_host: str = "127.0.0.1"  # loopback: reach it through an SSH tunnel
     view_fps: float = 10.0  # frames drawn and sent per second while a browser watches
-    # a periodic full scan runs after its frame's (tracked) readings are sent: latency, not CPU (docs/daemon-cost.md)
-    scan_after_send: bool = False
+    # a periodic full scan runs after its frame's (tracked) readings are sent: latency, not CPU (docs/daemon-cost.md);
+    # "auto": at source.fps >= 60 (latency-bound rates), not below (CPU-bound ones)
+    scan_after_send: Union[bool, str] = "auto"
 
 
 @frozen
@@ -232,7 +233,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "view_port": ck.number(0, 65535, integer=True),
             "view_host": ck.string,
             "view_fps": ck.number(0.1, 60),
-            "scan_after_send": ck.boolean,
+            "scan_after_send": ck.boolean_or("auto"),
         },
     ),
 }

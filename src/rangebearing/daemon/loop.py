@@ -213,7 +213,7 @@ class Daemon(Reloading):
 
     def _process(self, frame: Frame) -> Tuple[FrameResult, Optional[Callable[[], FrameResult]]]:
         """The frame's readings, and its periodic full scan if ``daemon.scan_after_send`` leaves it for later."""
-        if self.cfg.daemon.scan_after_send:  # a detector defect is this frame's (or its scan's): core/guarded
+        if scans_after_send(self.cfg):  # a detector defect is this frame's (or its scan's): core/guarded
             return scan_later_or_skip(self._pipe, frame.image, frame.t_mono_ns / 1e9, frame.lores_yuv420)
         return process_or_skip(self._pipe, frame.image, t_s=frame.t_mono_ns / 1e9, search=frame.lores_yuv420), None
 
@@ -250,6 +250,21 @@ class Daemon(Reloading):
             what = "reading not encodable, frame skipped" if isinstance(exc, ProtocolError) else "bad frame skipped"
             bug = exc.__cause__ if isinstance(exc, DetectorFault) else None  # a defect's traceback goes to the journal
             log.warning("%s (%d so far): %s", what, n, exc, exc_info=bug)
+
+
+AUTO_SCAN_AFTER_SEND_FPS = 60.0  # from here a frame period (<= 17 ms) is too short to wait for a full scan
+
+
+def scans_after_send(cfg: Config) -> bool:
+    """``daemon.scan_after_send``, with ``auto`` decided by the frame rate (docs/daemon-cost.md).
+
+    At 90 fps the periodic full scans set the p99 capture-to-send time (CPU
+    ~9-10 ms against ~4 ms with the scan after the send); at 30 fps that p99 is a
+    quarter of the frame period and the switch's extra tracked step (+3-10 % CPU a
+    frame) is what counts, against the 2 % budget.
+    """
+    v = cfg.daemon.scan_after_send
+    return v if isinstance(v, bool) else cfg.source.fps >= AUTO_SCAN_AFTER_SEND_FPS
 
 
 def _scanned(scan: Callable[[], FrameResult]) -> int:
