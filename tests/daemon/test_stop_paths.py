@@ -13,7 +13,7 @@ import pytest
 from rangebearing.cli.run_cmd import source_opener
 from rangebearing.config import load_config
 from rangebearing.daemon.loop import Daemon
-from rangebearing.errors import CameraError
+from rangebearing.errors import CameraError, CameraLibraryError
 from rangebearing.net.publisher import MemoryPublisher
 from tests.daemon.test_loop import RecordingNotifier, opener, recorded_cfg
 
@@ -93,3 +93,31 @@ def test_a_reload_to_a_recording_that_cannot_open_is_rejected_at_once(static_cli
     assert n[0] == 6  # frames went on from the old recording
     assert "reload rejected: cannot open the new frame source" in caplog.text
     assert "retrying" not in caplog.text  # a path that is not there does not appear by waiting
+
+
+def test_a_reload_to_a_camera_whose_library_is_missing_keeps_the_running_source(static_clip: Path, tmp_path: Path,
+                                                                                 caplog: pytest.LogCaptureFixture
+                                                                                 ) -> None:
+    cfg_file = tmp_path / "c.yaml"
+    cfg_file.write_text(f'source: {{kind: recorded, path: "{static_clip}", fps: 0, loop: true}}\n')
+
+    def open_source(cfg, sleep):
+        if cfg.source.kind == "picamera2":  # no picamera2 on this machine: not retried, and not fatal on a reload
+            raise CameraLibraryError("cannot import picamera2 (No module named 'picamera2')")
+        return opener(cfg, sleep)
+
+    daemon = Daemon(load_config(cfg_file), open_source, lambda c: MemoryPublisher(), RecordingNotifier(),
+                    reload=lambda: load_config(cfg_file))
+    n = [0]
+
+    def echo(payload: bytes) -> None:
+        n[0] += 1
+        if n[0] == 2:
+            cfg_file.write_text("source: {kind: picamera2}\n")
+            daemon.request_reload()
+        elif n[0] == 6:
+            daemon.stop()
+
+    daemon.echo = echo
+    assert daemon.run() == 0 and n[0] == 6
+    assert "reload rejected: cannot open the new frame source" in caplog.text

@@ -189,7 +189,7 @@ class CaptureGuard:
         try:
             if self.open(opener, budget_s=budget_s):
                 return True
-        except (CameraGone, SourceUnusable) as exc:
+        except (CameraGone, SourceUnusable, CameraLibraryError) as exc:  # a reload never ends the daemon
             log.error("reload rejected: cannot open the new frame source (%s); reopening the old one", exc)
         self.open(old, budget_s=old_budget_s)
         return False
