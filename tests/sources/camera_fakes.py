@@ -81,7 +81,7 @@ class Ours(Camera):
 
 class Alt(Camera):
     name = "alt"
-    timeout_s = 2.0  # free-running at 200 fps: generous for a loaded machine
+    timeout_s = 4.0  # free-running at 200 fps: generous for a loaded machine
 
     def __init__(self, module: ModuleType, rig: ModuleType) -> None:
         super().__init__(module)

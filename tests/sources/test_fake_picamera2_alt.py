@@ -6,6 +6,7 @@ These pin the fake itself, so that what the source tests lean on is the real lib
 from __future__ import annotations
 
 import os
+import stat
 import threading
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any, Iterator
@@ -129,7 +130,20 @@ def test_missing_and_busy_cameras_fail_as_the_real_constructor(alt_picamera2: An
     with pytest.raises(RuntimeError, match="did not complete") as busy:
         module.Picamera2(0)
     assert "busy" in str(busy.value.__cause__)
-    before = len(os.listdir("/proc/self/fd"))
+    before = _pipes()
     with pytest.raises(IndexError):
         module.Picamera2(1)
-    assert len(os.listdir("/proc/self/fd")) == before + 2  # the notify pipe, opened before the lookup (349-355)
+    assert len(_pipes() - before) == 2  # the notify pipe's two ends, opened before the lookup (349-355)
+
+
+def _pipes() -> set:
+    """(descriptor, inode) of every pipe this process holds."""
+    held = set()
+    for name in os.listdir("/proc/self/fd"):
+        try:
+            info = os.fstat(int(name))
+        except OSError:  # closed meanwhile (the listing's own descriptor)
+            continue
+        if stat.S_ISFIFO(info.st_mode):
+            held.add((int(name), info.st_ino))
+    return held

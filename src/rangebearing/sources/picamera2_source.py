@@ -122,7 +122,7 @@ class Picamera2Source:
             raise SourceError("Picamera2 source is not open")
         try:
             self._cam.set_controls(dict(controls))
-        except (RuntimeError, ValueError, TypeError) as exc:
+        except (RuntimeError, ValueError, TypeError, AttributeError) as exc:
             raise CameraError(f"camera {self._cfg.camera_num}: cannot set controls {controls}: {exc}") from exc
 
     def open(self) -> None:

@@ -81,7 +81,7 @@ class Rig:
     ticks: int = 0  # event-loop rounds run (any camera)
     tick: threading.Condition = field(default_factory=threading.Condition)
 
-    def wait_ticks(self, rounds: int, timeout_s: float = 10.0) -> bool:
+    def wait_ticks(self, rounds: int, timeout_s: float = 60.0) -> bool:
         """Block until the cameras' event loops ran `rounds` more rounds (a frame in flight has landed)."""
         with self.tick:
             goal = self.ticks + rounds
