@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import sys
 import time
+import types
 from typing import Any, List
 
 import numpy as np
@@ -194,16 +195,62 @@ def test_the_configuration_asked_for(camera: Camera) -> None:
 
 
 # ---------------------------------------------------------------- the clean-room fake only
-def test_a_missing_camera_is_never_constructed(alt_picamera2: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_missing_camera_is_constructed_only_on_the_last_attempt(alt_picamera2: Any,
+                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     module, rig = alt_picamera2
     rig.RIG.cameras = []
+    real = module.Picamera2.__init__
+    calls: List[int] = []
 
-    def constructed(*args: Any, **kw: Any) -> None:  # the real constructor leaks a pipe for a missing camera
-        raise AssertionError("Picamera2(n) called for a camera global_camera_info() does not list")
+    def counted(self: Any, camera_num: int = 0, **kw: Any) -> None:  # the real one leaks a pipe here
+        calls.append(camera_num)
+        real(self, camera_num, **kw)
 
-    monkeypatch.setattr(module.Picamera2, "__init__", constructed)
-    with pytest.raises(CameraError, match="no camera 0"):
-        Picamera2Source(SourceConfig(retries=2), sleep=no_sleep).open()
+    monkeypatch.setattr(module.Picamera2, "__init__", counted)
+    with pytest.raises(CameraError, match=r"no camera 0 \(0 found\)"):
+        Picamera2Source(SourceConfig(retries=3), sleep=no_sleep).open()
+    assert calls == [0]  # 4 attempts: 3 asked global_camera_info() first
+
+
+def test_a_camera_count_that_is_wrong_does_not_hide_the_camera(alt_picamera2: Any,
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    module, _ = alt_picamera2
+    monkeypatch.setattr(module.Picamera2, "global_camera_info", staticmethod(lambda: []))
+    source = Picamera2Source(SourceConfig(width_px=W, height_px=H, timeout_s=4.0, retries=1), sleep=no_sleep)
+    source.open()  # the constructor has the last word
+    try:
+        assert source.read() is not None
+    finally:
+        source.close()
+
+
+def test_a_create_video_configuration_with_only_the_core_keywords(alt_picamera2: Any,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    module, rig = alt_picamera2
+    libcamera = types.ModuleType("libcamera")  # a libcamera is there, but picamera2 takes no colour space
+    libcamera.ColorSpace = module.ColorSpace  # type: ignore[attr-defined]
+    libcamera.Transform = lambda hflip=False, vflip=False: (hflip, vflip)  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "libcamera", libcamera)
+    real = module.Picamera2.create_video_configuration
+
+    def core(self: Any, main: Any = None, lores: Any = None, buffer_count: int = 6, controls: Any = None,
+             queue: bool = True) -> dict:
+        return real(self, main=main or {}, lores=lores, buffer_count=buffer_count, controls=controls or {},
+                    queue=queue)
+
+    monkeypatch.setattr(module.Picamera2, "create_video_configuration", core)
+    rig.RIG.scene = lambda seq: noise(seq, H, W)
+    source = open_source(Alt(module, rig))
+    try:
+        frame = source.read()
+        assert frame is not None and frame.lores_yuv420 is not None
+        want = yuv420_from_bgr(frame.image)
+        assert np.abs(frame.lores_yuv420.v.astype(int) - want.v.astype(int)).max() <= 2
+    finally:
+        source.close()
+    with pytest.raises(CameraError, match="hflip/vflip"):
+        Picamera2Source(SourceConfig(vflip=True, retries=0), sleep=no_sleep).open()
+    assert rig.RIG.acquired == set()
 
 
 @pytest.mark.parametrize("missing", [

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import importlib
+import logging
 from typing import Any, Dict
 
 from ..config import SourceConfig
 from ..errors import CameraError, CameraLibraryError
 
+_log = logging.getLogger(__name__)
 INSTALL_HINT = "apt install python3-picamera2 and create the venv with --system-site-packages"
 
 
@@ -83,6 +85,23 @@ def video_configuration(cfg: SourceConfig, libcamera: Any) -> Dict[str, Any]:
         raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need libcamera.Transform, "
                           "and libcamera cannot be imported")
     return kwargs
+
+
+def create_configuration(cam: Any, cfg: SourceConfig, libcamera: Any) -> Dict[str, Any]:
+    """``cam.create_video_configuration`` for ``cfg``; a picamera2 that takes no ``colour_space`` / ``transform``
+    gets the core keywords only (its colour space is read from what it grants; flips then need it: CameraError).
+    """
+    kwargs = video_configuration(cfg, libcamera)
+    try:
+        return cam.create_video_configuration(**kwargs)
+    except TypeError:
+        if "colour_space" not in kwargs:
+            raise
+    if cfg.hflip or cfg.vflip:
+        raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need create_video_configuration(transform=)")
+    _log.warning("camera %d: create_video_configuration() takes no colour_space/transform: the camera's own",
+                 cfg.camera_num)
+    return cam.create_video_configuration(**video_configuration(cfg, None))
 
 
 def granted_configuration(cam: Any, asked: Dict[str, Any]) -> Dict[str, Any]:

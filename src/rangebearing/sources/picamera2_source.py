@@ -50,10 +50,10 @@ from .camera_setup import (
     camera_controls,
     camera_count,
     camera_count_text,
+    create_configuration,
     granted_configuration,
     import_module,
     optional_module,
-    video_configuration,
 )
 from .sensor_time import boot_offset_ns, frames_missed, sensor_to_monotonic_ns
 
@@ -134,7 +134,7 @@ class Picamera2Source:
         self._mapped = getattr(picamera2, "MappedArray", None)
         cfg = self._cfg
         try:
-            config = cam.create_video_configuration(**video_configuration(cfg, optional_module("libcamera")))
+            config = create_configuration(cam, cfg, optional_module("libcamera"))
             cam.configure(config)
             # what libcamera granted (validate() may adjust sizes, formats and the colour space)
             self._layout = granted(granted_configuration(cam, config), cfg.camera_num)
@@ -162,8 +162,9 @@ class Picamera2Source:
         for attempt in range(1, attempts + 1):
             try:
                 # Picamera2(n) looks n up in global_camera_info() only after opening a pipe it never closes
-                # when n is not there: ask first (a camera that is plugged in later is found on a retry)
-                if n >= camera_count(picamera2_cls):
+                # when n is not there: ask first (a camera plugged in later is found on a retry); the last
+                # attempt asks the constructor itself, in case the count is wrong (one pipe at most leaks)
+                if attempt < attempts and n >= camera_count(picamera2_cls):
                     raise IndexError(n)
                 return picamera2_cls(n)
             except IndexError:
