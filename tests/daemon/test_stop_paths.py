@@ -18,6 +18,23 @@ from rangebearing.net.publisher import MemoryPublisher
 from tests.daemon.test_loop import RecordingNotifier, opener, recorded_cfg
 
 
+def reload_at_second_frame(daemon: Daemon, cfg_file: Path, new_config: str) -> List[int]:
+    """After the second datagram the config file becomes ``new_config`` and a reload is asked for; a stop
+    after the sixth. Returns the datagram counter (``[n]``)."""
+    n = [0]
+
+    def echo(payload: bytes) -> None:
+        n[0] += 1
+        if n[0] == 2:
+            cfg_file.write_text(new_config)
+            daemon.request_reload()
+        elif n[0] == 6:
+            daemon.stop()
+
+    daemon.echo = echo
+    return n
+
+
 def test_a_stop_while_the_camera_is_still_missing_at_start_exits_0(static_clip: Path) -> None:
     calls: List[int] = []
     daemon: Daemon
@@ -78,17 +95,8 @@ def test_a_reload_to_a_recording_that_cannot_open_is_rejected_at_once(static_cli
     cfg_file.write_text(good)
     daemon = Daemon(load_config(cfg_file), source_opener, lambda c: MemoryPublisher(), RecordingNotifier(),
                     reload=lambda: load_config(cfg_file))
-    n = [0]
-
-    def echo(payload: bytes) -> None:
-        n[0] += 1
-        if n[0] == 2:
-            cfg_file.write_text(f'source: {{kind: recorded, path: "{tmp_path / "gone"}", fps: 0, loop: true}}\n')
-            daemon.request_reload()
-        elif n[0] == 6:
-            daemon.stop()
-
-    daemon.echo = echo
+    n = reload_at_second_frame(daemon, cfg_file,
+                               f'source: {{kind: recorded, path: "{tmp_path / "gone"}", fps: 0, loop: true}}\n')
     assert daemon.run() == 0
     assert n[0] == 6  # frames went on from the old recording
     assert "reload rejected: cannot open the new frame source" in caplog.text
@@ -108,16 +116,6 @@ def test_a_reload_to_a_camera_whose_library_is_missing_keeps_the_running_source(
 
     daemon = Daemon(load_config(cfg_file), open_source, lambda c: MemoryPublisher(), RecordingNotifier(),
                     reload=lambda: load_config(cfg_file))
-    n = [0]
-
-    def echo(payload: bytes) -> None:
-        n[0] += 1
-        if n[0] == 2:
-            cfg_file.write_text("source: {kind: picamera2}\n")
-            daemon.request_reload()
-        elif n[0] == 6:
-            daemon.stop()
-
-    daemon.echo = echo
+    n = reload_at_second_frame(daemon, cfg_file, "source: {kind: picamera2}\n")
     assert daemon.run() == 0 and n[0] == 6
     assert "reload rejected: cannot open the new frame source" in caplog.text

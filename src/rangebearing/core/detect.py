@@ -27,12 +27,12 @@ import numpy as np
 
 from .._compat import frozen
 from .blobs import mask_centroid
-from .color import RELAXED_WHITE_V, Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
-from .denoise import Box, band_masks, both_outside, median_filter
+from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
+from .denoise import Box, band_masks, median_filter
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
-from .structure import Candidate, Found, search
+from .structure import Candidate, Found, search, search_apart
 from .types import XY, BBox, LandmarkGeometry, union
 from .uncertainty import row_spread_px, silhouette_share
 
@@ -115,9 +115,7 @@ def search_candidates(
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
     if relaxed is not None:
-        if not both_outside(red, blue, relaxed, cfg.downscale):
-            return Found([], lambda: True)  # nothing to find: nothing unexplained
-        return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V, relaxed)
+        return search_apart(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, relaxed)
     return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 
 

@@ -32,7 +32,9 @@ from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
+from .color import RELAXED_WHITE_V
 from .columns import WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
+from .denoise import both_outside
 from .fragments import MIN_PIECE, Fragment, extend_along_bands, join_fragments, lit_like_bands, split_runs
 from .regions import MAX_REGIONS, band_regions, outside, partnered, region_stats  # noqa: F401  (region cap there)
 from .types import BBox, LandmarkGeometry
@@ -140,6 +142,18 @@ def search(
         reds, blues = outside(reds, apart, scale), outside(blues, apart, scale)
     found = _candidates(reds, blues, red, blue, hsv, scale, geometry, max_landmarks, white_v_min)
     return Found(found, functools.partial(explained, reds, blues, found, scale))
+
+
+def search_apart(
+    red: np.ndarray, blue: np.ndarray, hsv: np.ndarray, scale: int, geometry: LandmarkGeometry,
+    max_landmarks: int, min_area: int, apart: Sequence[Tuple[int, int, int, int]],
+) -> Found:
+    """The second look's :func:`search` (:func:`.balance.second_look`), in masks made at the lower colour
+    floors: the white body down to ``RELAXED_WHITE_V``, regions within the ``apart`` boxes not paired; not
+    searched at all when either mask holds nothing outside them (a landmark apart from them has both bands)."""
+    if not both_outside(red, blue, apart, scale):
+        return Found([], lambda: True)  # nothing to find: nothing unexplained
+    return search(red, blue, hsv, scale, geometry, max_landmarks, min_area, RELAXED_WHITE_V, apart)
 
 
 class Found(NamedTuple):

@@ -29,10 +29,10 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import RELAXED_WHITE_V, UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
-from .denoise import Box, band_masks, both_outside
+from .color import UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
+from .denoise import Box, band_masks
 from .params import DetectionParams
-from .structure import Found, search
+from .structure import Found, search, search_apart
 from .types import LandmarkGeometry
 
 # Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
@@ -267,7 +267,5 @@ def yuv_search(
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
     hsv = WindowHsv(y_half, yuv, gains)
     if relaxed is not None:
-        if not both_outside(red, blue, relaxed, 2):
-            return Found([], lambda: True)  # nothing to find: nothing unexplained
-        return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, RELAXED_WHITE_V, relaxed)
+        return search_apart(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area, relaxed)
     return search(red, blue, hsv, 2, geometry, cfg.max_landmarks, min_area)

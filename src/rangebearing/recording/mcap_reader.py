@@ -30,6 +30,7 @@ from .mcap_format import (
 PathLike = Union[str, "os.PathLike[str]"]
 log = logging.getLogger("rangebearing.recording")
 MAGIC = b"\x89MCAP0\r\n"
+_WARNED: set = set()  # (path, size, mtime) of damaged files already warned about (_damaged)
 
 
 def is_mcap(path: PathLike) -> bool:
@@ -96,8 +97,6 @@ def _damaged(path: str, offset: int, exc: BaseException) -> None:
     what = str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__
     log.warning("%s: cut short or damaged near byte %d (%s): nothing after it can be read", path, offset, what)
 
-
-_WARNED: set = set()
 
 
 class McapRecording:
