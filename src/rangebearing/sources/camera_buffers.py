@@ -15,6 +15,7 @@ import numpy as np
 
 from ..core.yuv import Yuv420, yuv420_planes
 from ..errors import CameraError
+from .camera_capture import Notes
 
 _log = logging.getLogger(__name__)
 
@@ -26,11 +27,11 @@ class Held:
     it, when :meth:`array` falls back to ``make_array``'s copy.
     """
 
-    def __init__(self, request: Any, mapped: Any, camera_num: int) -> None:
+    def __init__(self, request: Any, mapped: Any, notes: Notes) -> None:
         self.request = request
         self._mapped = mapped
         self._maps: List[Any] = []
-        self._camera_num = camera_num
+        self._notes = notes
 
     def array(self, stream: str) -> np.ndarray:
         """The stream's buffer: in place (kept mapped until :meth:`release`) or copied.
@@ -47,13 +48,13 @@ class Held:
                     m = self._mapped(self.request, stream)
                 m.__enter__()
             except Exception as exc:  # any failure to map: copy instead, and say so once
-                _log.warning("camera %d: MappedArray failed (%s): copying frames with make_array",
-                             self._camera_num, exc)
+                self._notes.once("map", "MappedArray failed (%s): copying frames with make_array", exc)
                 self._mapped = None
             else:
                 self._maps.append(m)
-                if m.array is not None:
-                    return m.array
+                array = getattr(m, "array", None)
+                if array is not None:
+                    return array
         return self.request.make_array(stream)
 
     @property
@@ -67,12 +68,12 @@ class Held:
             try:
                 m.__exit__(None, None, None)
             except Exception as exc:  # keep going: the buffer must go back to the camera
-                _log.warning("camera %d: unmapping failed: %s", self._camera_num, exc)
+                self._notes.once("unmap", "unmapping failed: %s", exc)
         self._maps = []
         try:
             self.request.release()
-        except RuntimeError as exc:
-            _log.warning("camera %d: release failed: %s", self._camera_num, exc)
+        except Exception as exc:  # deliberately broad: a release that fails must not end the frame loop
+            self._notes.once("release", "release failed: %s", exc)
 
 
 class ArrayRequest:
@@ -128,7 +129,7 @@ class Layout:
             return None
         try:
             yuv = yuv420_planes(buffer, self.lores_size[0], self.lores_size[1], self.colour_space)
-        except ValueError as exc:  # an odd buffer: say so once, then search the main image
+        except (ValueError, TypeError, AttributeError) as exc:  # an odd buffer: say so once, search the main image
             if not self._warned:
                 _log.warning("camera %d: lores stream unusable, searching the main image: %s", self._camera_num, exc)
                 self._warned = True
@@ -152,7 +153,11 @@ def granted(active: Dict[str, Any], camera_num: int) -> Layout:
             big = int(main["size"][0]) >= 1280 and int(main["size"][1]) >= 720
             matrix = "rec709" if big else "smpte170m"
         lores_fmt = str(lores.get("format"))
-        if lores_fmt not in ("YUV420", "YVU420") or matrix is None:
+        same_size = [int(v) for v in lores.get("size", ())] == [int(v) for v in main["size"]]
+        if not same_size:  # the search reads the lores planes at the main image's scale (its U, V at half)
+            _log.warning("camera %d: lores stream granted at %s, not the main stream's %s: searching the main "
+                         "image instead", camera_num, lores.get("size"), main["size"])
+        elif lores_fmt not in ("YUV420", "YVU420") or matrix is None:
             _log.warning("camera %d: lores stream granted as %s in colour space %s, which the search cannot read: "
                          "searching the main image instead", camera_num, lores_fmt, active.get("colour_space"))
             matrix = "smpte170m"

@@ -46,6 +46,7 @@ from ..core.yuv import Yuv420
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
 from .camera_buffers import ArrayRequest, Held, Layout, copied, granted
+from .camera_capture import Capturer, Notes, sensor_fields
 from .camera_setup import (
     camera_controls,
     camera_count,
@@ -105,6 +106,8 @@ class Picamera2Source:
         self._next_index = 0
         self._dropped = 0
         self._budget = TimeoutBudget(f"camera {cfg.camera_num}", cfg.timeout_s, cfg.retries)
+        self._notes = Notes(cfg.camera_num)
+        self._capturer = Capturer(self._notes, cfg.timeout_s)
         self._metadata: Dict[str, Any] = {}
 
     @property
@@ -191,18 +194,21 @@ class Picamera2Source:
         try:
             request = self._capture(cam)
         except _TIMEOUTS:
-            raise self._timed_out(cam) from None
-        except (RuntimeError, concurrent.futures.CancelledError) as exc:
-            raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc}") from exc
+            self._capturer.flush(cam)  # the timed-out job is still queued: it would swallow a frame
+            raise self._budget.timed_out() from None
+        except (FrameError, CameraError):
+            raise
+        except Exception as exc:  # deliberately broad: whatever the library raises, the capture is retried
+            raise CameraError(f"camera {self._cfg.camera_num}: capture failed: {exc!r}") from exc
         received_ns = self._clock()
-        held = self._held = Held(request, self._mapped, self._cfg.camera_num)
+        held = self._held = Held(request, self._mapped, self._notes)
         layout = self._layout
         try:
             array = held.array("main")
-            metadata = request.get_metadata()
-        except (RuntimeError, ValueError) as exc:
+        except Exception as exc:  # deliberately broad: a request that cannot give its image is a skipped frame
             self._release_held()
-            raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc}") from exc
+            raise FrameError(f"camera {self._cfg.camera_num}: unusable request: {exc!r}") from exc
+        metadata = self._capturer.metadata(request)
         self._mapped = held.mapped
         lores = self._lores(held) if layout.lores_size else None  # type: ignore[union-attr]
         self._budget.frame_arrived()
@@ -224,39 +230,30 @@ class Picamera2Source:
         """The next completed request; a picamera2 without ``capture_request`` gives main arrays only."""
         capture = getattr(cam, "capture_request", None)
         if capture is not None:
-            return capture(wait=self._cfg.timeout_s)
+            return self._capturer.request(capture)
         if self._layout is not None and self._layout.lores_size is not None:
             _log.warning("camera %d: no capture_request(): main stream only, searched in full",
                          self._cfg.camera_num)
             self._layout.lores_size = None
-        return ArrayRequest(cam.capture_array("main", wait=self._cfg.timeout_s))
+        return ArrayRequest(self._capturer.call(lambda **wait: cam.capture_array("main", **wait)))
 
     def _lores(self, held: Held) -> Optional[np.ndarray]:
         """The lores buffer, or None from now on if the request cannot give it (the main image is searched)."""
         try:
             return held.array("lores")
-        except (RuntimeError, ValueError, KeyError, AttributeError) as exc:
+        except Exception as exc:  # deliberately broad: without lores the main image is searched
             _log.warning("camera %d: no lores stream in the request (%s): searching the main image",
                          self._cfg.camera_num, exc)
             self._layout.lores_size = None  # type: ignore[union-attr]
             return None
 
-    def _timed_out(self, cam: Any) -> Exception:
-        # The timed-out job is still queued: flush it before it swallows a frame (and leaks its request).
-        flush = getattr(cam, "cancel_all_and_flush", None)
-        if flush is not None:
-            flush()
-        return self._budget.timed_out()
-
     def _stamp(self, image: np.ndarray, search: Optional[Yuv420], metadata: Dict[str, Any],
                received_ns: int) -> Frame:
-        sensor_ns = metadata.get("SensorTimestamp")
+        sensor_ns, duration_us = sensor_fields(metadata)
         if sensor_ns is None:
             t_ns = received_ns
         else:
-            sensor_ns = int(sensor_ns)
             t_ns = sensor_to_monotonic_ns(sensor_ns, received_ns, self._boot_offset_ns)
-            duration_us = metadata.get("FrameDuration")
             fps = self._cfg.fps
             period_ns = duration_us * 1e3 if duration_us else (1e9 / fps if fps > 0 else 0.0)
             missed = frames_missed(self._prev_sensor_ns, sensor_ns, period_ns)

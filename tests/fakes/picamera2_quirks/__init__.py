@@ -1,0 +1,314 @@
+"""A third picamera2 stand-in: the documented API, each corner it may take on its own switched on by name.
+
+Written from picamera2's source (picamera2.py, request.py, job.py at 3e6dff0) and its manual, as a fake
+someone else might write: no libcamera module, lockstep frames (one made per capture), and in ``QUIRKS``
+the ways such a fake (or an older or newer picamera2) can differ from ours while staying within what the
+library documents or has done:
+
+- ``no_wait``: ``capture_request()`` / ``capture_array()`` take no ``wait=`` (picamera2 before 0.3.9).
+- ``builtin_timeout``: a stalled capture raises the builtin ``TimeoutError`` (Python ≥ 3.11 futures).
+- ``flush_fails``: ``cancel_all_and_flush()`` raises RuntimeError ("Camera not started").
+- ``no_metadata``: requests have no ``get_metadata``; ``metadata_none``: it returns None.
+- ``none_request``: one ``capture_request`` in ``none_every`` returns None.
+- ``lores_unpadded``: lores YUV420 as (H·3/2, W), no stride padding; main rows are padded (64 bytes) anyway.
+- ``lores_smaller``: libcamera grants the lores stream at half the size asked.
+- ``map_fails``: ``MappedArray.__enter__`` raises RuntimeError("failed to find buffer") (request.py _MappedBuffer).
+- ``xbgr``: main granted as XBGR8888 ([R, G, B, 255] bytes).
+- ``release_fails``: ``release()`` raises RuntimeError (negative ref_count, request.py 117-118).
+- ``make_array_fails``: ``make_array`` raises RuntimeError("Format ... not supported") for the main stream once.
+- ``close_fails``: ``stop()`` and ``close()`` raise RuntimeError.
+- ``float_timestamp``: ``SensorTimestamp`` is a float; ``no_frame_duration``: no ``FrameDuration``.
+- ``tuple_config``: ``camera_configuration()`` returns lists for sizes and a plain string colour space.
+
+``SCENE(sequence) -> (H, W, 3)`` gives the frames in TRUE (R, G, B) order; ``STALLED`` makes captures wait.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import threading
+from typing import Any, Callable, Dict, List, Optional
+
+import numpy as np
+
+QUIRKS: set = set()
+NONE_EVERY = 3
+STALLED = threading.Event()
+OPEN: set = set()
+HELD: List[CompletedRequest] = []
+INSTANCES: List[Picamera2] = []
+
+
+def _default_scene(sequence: int, height: int, width: int) -> np.ndarray:
+    rgb = np.zeros((height, width, 3), np.uint8)
+    rgb[..., 0] = (sequence * 7) % 256
+    rgb[..., 1] = 128
+    rgb[..., 2] = 255 - (sequence * 7) % 256
+    return rgb
+
+
+SCENE: Callable[[int, int, int], np.ndarray] = _default_scene
+
+
+def _from_env() -> None:
+    """For a ``rangebearing run`` process: PICAMERA2_QUIRKS="no_wait,release_fails", PICAMERA2_SCENE=<RGB .npy>."""
+    global SCENE
+    QUIRKS.update(q for q in os.environ.get("PICAMERA2_QUIRKS", "").split(",") if q)
+    path = os.environ.get("PICAMERA2_SCENE")
+    if path:
+        image = np.load(path)
+        SCENE = lambda sequence, height, width: image  # noqa: E731
+
+
+_from_env()
+
+
+def reset() -> None:
+    """Defaults again (a test's teardown), every camera closed."""
+    global SCENE, NONE_EVERY
+    for cam in list(INSTANCES):
+        cam.close()
+    QUIRKS.clear()
+    STALLED.clear()
+    OPEN.clear()
+    HELD.clear()
+    INSTANCES.clear()
+    SCENE, NONE_EVERY = _default_scene, 3
+
+
+def _rgb_to_yuv420(rgb: np.ndarray, stride: int) -> np.ndarray:
+    """SMPTE 170M limited-range I420, (H·3/2, stride) with the chroma rows stride/2 (picamera2's layout)."""
+    h, w = rgb.shape[:2]
+    r, g, b = (rgb[..., i].astype(np.float64) for i in range(3))
+    y = 16 + (65.481 * r + 128.553 * g + 24.966 * b) / 255
+    u = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255
+    v = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255
+    out = np.zeros((h * 3 // 2, stride), np.uint8)
+    out[:h, :w] = np.clip(np.rint(y), 0, 255)
+    chroma = out[h:].reshape(2, h // 2, stride // 2)
+    for plane, src in zip(chroma, (u, v)):
+        half = src.reshape(h // 2, 2, w // 2, 2).mean(axis=(1, 3))
+        plane[:, : w // 2] = np.clip(np.rint(half), 0, 255)
+    return out
+
+
+class Job:
+    """What a false ``wait`` returns (job.py): ``get_result(timeout)``."""
+
+    def __init__(self, result: Any) -> None:
+        self._result = result
+
+    def get_result(self, timeout: Optional[float] = None) -> Any:
+        return self._result
+
+
+class CompletedRequest:
+    def __init__(self, cam: Picamera2, sequence: int) -> None:
+        self.picam2 = cam
+        self.config = cam.camera_config
+        self.ref_count = 1
+        self.sequence = sequence
+        self.buffers: Dict[str, np.ndarray] = {}
+        rgb = SCENE(sequence, *reversed(cam.asked_main))
+        main = cam.camera_config["main"]
+        w, h = main["size"]
+        if main["format"] == "XBGR8888":
+            pixels = np.concatenate([rgb, np.full((*rgb.shape[:2], 1), 255, np.uint8)], axis=2)
+        else:  # RGB888: [B, G, R] bytes
+            pixels = rgb[..., ::-1]
+        flat = np.zeros((h, main["stride"]), np.uint8)
+        flat[:, : pixels.shape[1] * pixels.shape[2]] = pixels.reshape(h, -1)
+        self.buffers["main"] = flat
+        lores = cam.camera_config.get("lores")
+        if lores is not None:
+            lw, lh = lores["size"]
+            small = rgb if (lw, lh) == (w, h) else rgb[::h // lh, ::w // lw][:lh, :lw]
+            self.buffers["lores"] = _rgb_to_yuv420(np.ascontiguousarray(small), lores["stride"])
+
+    def _shaped(self, name: str) -> np.ndarray:
+        cfg = self.config[name]
+        buf = self.buffers[name]
+        w, h = cfg["size"]
+        fmt = cfg["format"]
+        if fmt == "RGB888":
+            return buf[:, : w * 3].reshape(h, w, 3)
+        if fmt == "XBGR8888":
+            return buf[:, : w * 4].reshape(h, w, 4)
+        return buf  # YUV420: (H·3/2, stride), padding kept
+
+    def make_buffer(self, name: str) -> np.ndarray:
+        return self.buffers[name].reshape(-1).copy()
+
+    def make_array(self, name: str) -> np.ndarray:
+        if self.ref_count <= 0:
+            raise RuntimeError("CompletedRequest: request already released")
+        if "make_array_fails" in QUIRKS and name == "main" and self.sequence == 1:
+            raise RuntimeError("Format XYZ not supported")
+        return self._shaped(name).copy()
+
+    @property
+    def get_metadata(self) -> Callable[[], Optional[Dict[str, Any]]]:
+        if "no_metadata" in QUIRKS:  # a request with no get_metadata at all
+            raise AttributeError("get_metadata")
+        return self._metadata
+
+    def _metadata(self) -> Optional[Dict[str, Any]]:
+        if "metadata_none" in QUIRKS:
+            return None
+        ts = 1_000_000_000 + self.sequence * self.picam2.frame_us * 1000
+        meta: Dict[str, Any] = {"SensorTimestamp": float(ts) if "float_timestamp" in QUIRKS else ts}
+        if "no_frame_duration" not in QUIRKS:
+            meta["FrameDuration"] = self.picam2.frame_us
+        return meta
+
+    def release(self) -> None:
+        self.ref_count -= 1
+        if self in HELD:
+            HELD.remove(self)
+        if self.ref_count < 0 or "release_fails" in QUIRKS:
+            raise RuntimeError("CompletedRequest: lock now has negative ref_count")
+        self.buffers = {k: np.full_like(v, 0xEE) for k, v in self.buffers.items()}  # recycled
+
+
+class MappedArray:
+    def __init__(self, request: CompletedRequest, stream: str, reshape: bool = True, write: bool = True) -> None:
+        self._request, self._stream = request, stream
+        self.array: Optional[np.ndarray] = None
+
+    def __enter__(self) -> MappedArray:
+        if "map_fails" in QUIRKS:
+            raise RuntimeError("failed to find buffer")
+        self.array = self._request._shaped(self._stream)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.array = None
+
+
+class Picamera2:
+    def __init__(self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None,
+                 allocator: Any = None) -> None:
+        if camera_num != 0:
+            raise IndexError("list index out of range")
+        if camera_num in OPEN:
+            raise RuntimeError("Camera __init__ sequence did not complete.")
+        OPEN.add(camera_num)
+        self.camera_num = camera_num
+        self.camera_config: Dict[str, Any] = {}
+        self.started = False
+        self.closed = False
+        self.sequence = 0
+        self.frame_us = 33333
+        self.asked_main = (640, 480)
+        INSTANCES.append(self)
+
+    @staticmethod
+    def global_camera_info() -> List[Dict[str, Any]]:
+        return [{"Model": "imx219", "Location": 2, "Rotation": 0, "Id": "/base/imx219@10", "Num": 0}]
+
+    def create_video_configuration(self, main: Optional[dict] = None, lores: Optional[dict] = None,
+                                   raw: Any = None, transform: Any = None, colour_space: Any = None,
+                                   buffer_count: int = 6, controls: Optional[dict] = None, **kw: Any) -> dict:
+        for key in kw:
+            if key not in ("display", "encode", "queue", "sensor", "use_case"):
+                raise TypeError(f"create_video_configuration() got an unexpected keyword argument {key!r}")
+        return {"use_case": "video", "transform": transform, "colour_space": colour_space,
+                "buffer_count": buffer_count, "queue": True, "main": dict(main or {"format": "XBGR8888",
+                                                                                   "size": (1280, 720)}),
+                "lores": None if lores is None else dict(lores), "raw": None,
+                "controls": dict(controls or {}), "sensor": {}, "display": "main", "encode": "main"}
+
+    def configure(self, config: Any = None) -> None:
+        if self.started:
+            raise RuntimeError("Camera must be stopped before configuring")
+        config = dict(config)
+        main = config["main"]
+        w, h = (int(v) for v in main["size"])
+        self.asked_main = (w, h)
+        fmt = "XBGR8888" if "xbgr" in QUIRKS else main["format"]
+        bpp = 4 if fmt == "XBGR8888" else 3
+        main.update(format=fmt, size=(w, h), stride=((w * bpp + 63) // 64) * 64)
+        main["framesize"] = main["stride"] * h
+        lores = config.get("lores")
+        if lores is not None:
+            lw, lh = (int(v) for v in lores["size"])
+            if "lores_smaller" in QUIRKS:
+                lw, lh = lw // 2, lh // 2
+            stride = lw if "lores_unpadded" in QUIRKS else ((lw + 63) // 64) * 64
+            lores.update(size=(lw, lh), stride=stride, framesize=stride * lh * 3 // 2)
+        if config.get("colour_space") is None:
+            config["colour_space"] = "Smpte170m" if w < 1280 else "Rec709"
+        if "FrameDurationLimits" in config.get("controls", {}):
+            self.frame_us = int(config["controls"]["FrameDurationLimits"][0])
+        if "tuple_config" in QUIRKS:
+            main["size"] = list(main["size"])
+            config["colour_space"] = str(config["colour_space"])
+        self.camera_config = config
+
+    def camera_configuration(self) -> Dict[str, Any]:
+        return self.camera_config
+
+    def stream_configuration(self, name: str = "main") -> Dict[str, Any]:
+        return self.camera_config[name]
+
+    def start(self, config: Any = None, show_preview: bool = False) -> None:
+        if not self.camera_config:
+            raise RuntimeError("Camera has not been configured")
+        self.started = True
+
+    def _next(self, timeout: Optional[float]) -> CompletedRequest:
+        if not self.started:
+            raise RuntimeError("Camera not started")
+        if STALLED.is_set():
+            if timeout is None:
+                raise RuntimeError("a capture without wait= would block for ever: this fake refuses")
+            STALLED.wait(0)  # no frame comes
+            if "builtin_timeout" in QUIRKS:
+                raise TimeoutError()
+            raise concurrent.futures.TimeoutError()
+        self.sequence += 1
+        request = CompletedRequest(self, self.sequence)
+        HELD.append(request)
+        return request
+
+    def capture_request(self, *args: Any, **kwargs: Any) -> Any:
+        if "no_wait" in QUIRKS and (args or kwargs):
+            raise TypeError("capture_request() takes 1 positional argument but more were given")
+        wait = kwargs.get("wait", args[0] if args else None)
+        if wait is not None and not wait:
+            return Job(self._next(None))
+        if "none_request" in QUIRKS and (self.sequence + 1) % NONE_EVERY == 0:
+            self.sequence += 1
+            return None
+        return self._next(wait if "no_wait" not in QUIRKS else 1.0)
+
+    def capture_array(self, name: str = "main", *args: Any, **kwargs: Any) -> np.ndarray:
+        if "no_wait" in QUIRKS and (args or kwargs):
+            raise TypeError("capture_array() takes 2 positional arguments but more were given")
+        request = self._next(kwargs.get("wait", 1.0))
+        try:
+            return request.make_array(name)
+        finally:
+            request.release()
+
+    def cancel_all_and_flush(self) -> None:
+        if "flush_fails" in QUIRKS:
+            raise RuntimeError("Camera not started")
+
+    def set_controls(self, controls: Dict[str, Any]) -> None:
+        self.camera_config.setdefault("controls", {}).update(controls)
+
+    def stop(self) -> None:
+        if "close_fails" in QUIRKS:
+            raise RuntimeError("stop failed")
+        self.started = False
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        self.started = False
+        OPEN.discard(self.camera_num)
+        if "close_fails" in QUIRKS:
+            raise RuntimeError("close failed")

@@ -1,0 +1,199 @@
+"""Picamera2Source against a third stand-in (tests/fakes/picamera2_quirks): each documented corner on its own.
+
+Every quirk must give frames of the right colours (or a counted skip: FrameError), timeouts as FrameError then
+CameraError, and a close that returns: never another exception out of ``read()``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from types import ModuleType
+from typing import Iterator
+
+import numpy as np
+import pytest
+
+from rangebearing.config import SourceConfig
+from rangebearing.errors import CameraError, FrameError
+from rangebearing.sources.camera_capture import sensor_fields
+from rangebearing.sources.picamera2_source import Picamera2Source
+from tests.conftest import FAKES
+
+QUIRKS_DIR = FAKES / "picamera2_quirks"
+TIMEOUT_S = 60.0
+
+
+@pytest.fixture
+def quirky(monkeypatch: pytest.MonkeyPatch) -> Iterator[ModuleType]:
+    """The quirks fake as ``picamera2`` (and no importable libcamera) for one test."""
+    init = QUIRKS_DIR / "__init__.py"
+    spec = importlib.util.spec_from_file_location("picamera2", init, submodule_search_locations=[str(QUIRKS_DIR)])
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "picamera2", module)
+    monkeypatch.setitem(sys.modules, "libcamera", None)  # import libcamera raises ImportError
+    spec.loader.exec_module(module)
+    module.reset()
+    yield module
+    module.reset()
+
+
+def source(in_place: bool = True, **cfg: object) -> Picamera2Source:
+    base = {"timeout_s": 0.05, "retries": 3, **cfg}
+    return Picamera2Source(SourceConfig(**base), in_place=in_place, stop_timeout_s=5.0)  # type: ignore[arg-type]
+
+
+def true_bgr(sequence: int) -> list:
+    """The quirks fake's default scene at ``sequence``, as B, G, R."""
+    return [255 - (sequence * 7) % 256, 128, (sequence * 7) % 256]
+
+
+# quirk -> does lores survive it
+FRAME_QUIRKS = {
+    "no_wait": True, "builtin_timeout": True, "no_metadata": True, "metadata_none": True, "lores_unpadded": True,
+    "lores_smaller": False, "map_fails": True, "xbgr": True, "release_fails": True, "close_fails": True,
+    "float_timestamp": True, "no_frame_duration": True, "tuple_config": True, "flush_fails": True,
+}
+
+
+@pytest.mark.parametrize("in_place", [True, False])
+@pytest.mark.parametrize("quirk", sorted(FRAME_QUIRKS))
+def test_every_quirk_gives_true_frames_then_timeouts_then_a_clean_close(quirky: ModuleType, quirk: str,
+                                                                        in_place: bool) -> None:
+    quirky.QUIRKS.add(quirk)
+    src = source(in_place)
+    src.open()
+    for sequence in range(1, 5):
+        frame = src.read()
+        assert frame is not None and frame.image.shape == (480, 640, 3)
+        assert frame.image[10, 10].tolist() == true_bgr(sequence)
+        if FRAME_QUIRKS[quirk]:
+            assert frame.lores_yuv420 is not None and frame.lores_yuv420.u.shape == (240, 320)
+            u = int(frame.lores_yuv420.u[5, 5])
+            assert (u > 128) == (true_bgr(sequence)[0] > true_bgr(sequence)[2])  # blue over red: U above 128
+        else:
+            assert frame.lores_yuv420 is None
+    quirky.STALLED.set()
+    with pytest.raises(FrameError):
+        src.read()
+    with pytest.raises(FrameError):
+        src.read()
+    with pytest.raises(CameraError, match="3 times in a row"):
+        src.read()
+    src.close()
+    assert not quirky.OPEN and not quirky.HELD  # released and closed, whatever stop()/close() raised
+
+
+def test_a_capture_that_returns_nothing_is_one_skipped_frame(quirky: ModuleType) -> None:
+    quirky.QUIRKS.add("none_request")
+    src = source()
+    src.open()
+    got = []
+    for _ in range(5):
+        try:
+            got.append(src.read().image[10, 10].tolist())  # type: ignore[union-attr]
+        except FrameError as exc:
+            assert "returned no request" in str(exc)
+            got.append(None)
+    src.close()
+    assert got == [true_bgr(1), true_bgr(2), None, true_bgr(4), true_bgr(5)]
+
+
+def test_main_stream_that_cannot_be_read_is_a_skipped_frame_not_a_crash(quirky: ModuleType) -> None:
+    quirky.QUIRKS.update({"map_fails", "make_array_fails"})  # frame 1: MappedArray fails, then make_array too
+    src = source()
+    src.open()
+    with pytest.raises(FrameError, match="unusable request"):
+        src.read()
+    assert src.read().image[10, 10].tolist() == true_bgr(2)  # type: ignore[union-attr]
+    src.close()
+    assert not quirky.HELD  # the failed request was given back
+
+
+def test_a_library_quirk_is_said_once_not_every_frame(quirky: ModuleType, caplog: pytest.LogCaptureFixture) -> None:
+    quirky.QUIRKS.update({"release_fails", "no_wait"})
+    src = source()
+    src.open()
+    with caplog.at_level(logging.DEBUG, logger="rangebearing"):
+        for _ in range(6):
+            src.read()
+    src.close()
+    warnings = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert sum("release failed" in w for w in warnings) == 1, warnings
+    assert sum("takes no wait=" in w for w in warnings) == 1, warnings
+
+
+def test_a_job_handed_back_for_the_capture_is_waited_for(quirky: ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:
+    real = quirky.Picamera2.capture_request
+    monkeypatch.setattr(quirky.Picamera2, "capture_request", lambda self, wait=None: real(self, wait=False))
+    src = source()
+    src.open()
+    assert src.read().image[10, 10].tolist() == true_bgr(1)  # type: ignore[union-attr]
+    src.close()
+
+
+def test_an_unexpected_library_error_is_a_camera_error_the_daemon_retries(quirky: ModuleType,
+                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    def broken(self: object, wait: object = None) -> None:
+        raise OSError(5, "Input/output error")
+
+    monkeypatch.setattr(quirky.Picamera2, "capture_request", broken)
+    src = source()
+    src.open()
+    with pytest.raises(CameraError, match=r"capture failed.*Input/output error"):
+        src.read()
+    src.close()
+
+
+@pytest.mark.parametrize("meta, want", [
+    ({"SensorTimestamp": 12, "FrameDuration": 33333}, (12, 33333.0)),
+    ({"SensorTimestamp": 12.7}, (12, None)),
+    ({"SensorTimestamp": "soon", "FrameDuration": "x"}, (None, None)),
+    ({"SensorTimestamp": None, "FrameDuration": 0}, (None, None)),
+    ({"SensorTimestamp": float("inf"), "FrameDuration": float("nan")}, (None, None)),
+    ({}, (None, None)),
+])
+def test_sensor_fields_take_only_numbers(meta: dict, want: tuple) -> None:
+    assert sensor_fields(meta) == want
+
+
+def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path) -> None:
+    from rangebearing.net.client import Subscriber
+    from rangebearing.synth import render
+    from tests.conftest import STATIC_SCENE
+    from tests.daemon.test_e2e import check_truth, wait_reading
+
+    np.save(tmp_path / "scene.npy", np.ascontiguousarray(render(STATIC_SCENE, np.random.default_rng(3))[:, :, ::-1]))
+    site = tmp_path / "site" / "picamera2"
+    site.mkdir(parents=True)
+    (site / "__init__.py").write_text(f"exec(compile(open({str(QUIRKS_DIR / '__init__.py')!r}).read(), "
+                                      f"{str(QUIRKS_DIR / '__init__.py')!r}, 'exec'))\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path / "site"), os.environ.get("PYTHONPATH", "")]),
+           "PICAMERA2_QUIRKS": "no_wait,no_metadata,release_fails,flush_fails,xbgr,lores_unpadded,close_fails",
+           "PICAMERA2_SCENE": str(tmp_path / "scene.npy")}
+    with Subscriber(port=0, timeout_s=TIMEOUT_S) as sub:
+        (tmp_path / "config.yaml").write_text(f"""
+source: {{kind: picamera2, fps: 30, timeout_s: 1.0}}
+publish: {{robot_id: pi, unicast: ["127.0.0.1:{sub.port}"]}}
+""")
+        proc = subprocess.Popen([sys.executable, "-m", "rangebearing.cli.main", "run", "--config",
+                                 str(tmp_path / "config.yaml")], env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        try:
+            for _ in range(3):
+                check_truth(wait_reading(sub, "pi", timeout_s=TIMEOUT_S))
+            proc.send_signal(signal.SIGTERM)
+            code = proc.wait(timeout=TIMEOUT_S)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+            _, stderr = proc.communicate()
+    assert code == 0, stderr
+    assert "Traceback" not in stderr, stderr
+    assert stderr.count("release failed") == 1, stderr  # said once, not at every frame
