@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Dict, Iterable, Iterator, List, Optional, TypeVar, Union
 
 from ..config import Config, SourceConfig, dump_config, load_config
+from ..config.schema import MAX_CAMERA_NUM, MAX_FPS
 from ..errors import ConfigError, OutputError
 from ..net.protocol import LandmarkLike, Reading
 
@@ -132,11 +133,15 @@ def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[S
     if spec is None and fps is None and not loop:
         return None
     src = base
+    if spec is not None and not spec.strip():
+        raise ConfigError(["--source: empty: name a source (picamera2[:N], opencv:DEVICE, synthetic, or a folder "
+                           "of images or a video file)"], "command line")
     if spec:
         kind, _, rest = spec.partition(":")
         if kind == "picamera2":
-            if rest and not rest.isdigit():
-                raise ConfigError([f"--source: {spec!r}: the camera number must be an integer"], "command line")
+            if rest and not (rest.isdigit() and int(rest) <= MAX_CAMERA_NUM):
+                raise ConfigError([f"--source: {spec!r}: the camera number must be an integer from 0 to "
+                                   f"{MAX_CAMERA_NUM}"], "command line")
             src = dataclasses.replace(src, kind="picamera2", camera_num=int(rest) if rest else src.camera_num)
         elif kind == "opencv":
             if not rest:  # "opencv:" meaning device 0 silently surprised people: say which one
@@ -152,8 +157,8 @@ def source_from_args(args: argparse.Namespace, base: SourceConfig) -> Optional[S
                                    "synthetic) nor an existing folder of images or video file"], "command line")
             src = dataclasses.replace(src, kind="recorded", path=path)
     if fps is not None:
-        if fps < 0:
-            raise ConfigError(["--fps: must be >= 0"], "command line")
+        if not 0.0 <= fps <= MAX_FPS:  # NaN too; the config's own bound (source.fps)
+            raise ConfigError([f"--fps: must be a number from 0 to {MAX_FPS:g}, got {fps:g}"], "command line")
         src = dataclasses.replace(src, fps=fps)
     if loop:
         src = dataclasses.replace(src, loop=True)

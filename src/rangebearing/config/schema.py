@@ -19,6 +19,8 @@ from . import checks as ck
 
 DEFAULT_PORT = 47800
 SOURCES = ("recorded", "opencv", "picamera2", "synthetic")
+MAX_FPS = 1000.0  # source.fps (and --fps) at most
+MAX_CAMERA_NUM = 16  # source.camera_num (and picamera2:N) at most
 # No frame for timeout_s × retries seconds: the daemon reopens the camera halfway, then exits
 # cleanly for systemd to restart it, always before the unit's WatchdogSec=20s would SIGABRT it.
 MAX_CAPTURE_BUDGET_S = 12.0
@@ -190,10 +192,10 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
         {
             "kind": ck.choice(*SOURCES),
             "path": ck.string,
-            "fps": ck.number(0, 1000),
+            "fps": ck.number(0, MAX_FPS),
             "loop": ck.boolean,
             "device": ck.string,
-            "camera_num": ck.number(0, 16, integer=True),
+            "camera_num": ck.number(0, MAX_CAMERA_NUM, integer=True),
             "width_px": ck.positive(True),
             "height_px": ck.positive(True),
             "hflip": ck.boolean,
