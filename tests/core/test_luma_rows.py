@@ -73,6 +73,17 @@ def test_the_luma_edge_is_taken_when_the_chroma_edge_lies_a_little_into_the_body
     assert luma_inner(q, 39 - 20.3 - offset, False, 8.0) == pytest.approx(39 - 20.3, abs=1e-4)
 
 
+@pytest.mark.parametrize("offset", [2.5, 3.0, 3.5])
+def test_a_chroma_edge_bled_3_px_into_the_body_still_takes_the_luma_edge_in_a_tall_enough_band(offset):
+    # video coding smears chroma 3-4 px into the body: the luma edge lies inside the chroma-bled band
+    p = _luma_profile(20.3)
+    assert luma_inner(p, 20.3 + offset, True, 10.0) == pytest.approx(20.3, abs=0.35)
+    q = p[::-1].copy()
+    assert luma_inner(q, 39 - 20.3 - offset, False, 10.0) == pytest.approx(39 - 20.3, abs=0.35)
+    # ... but never past the band's middle: a 5 px band cannot have bled 2.5 px or more
+    assert luma_inner(p, 20.3 + offset, True, 5.0) is None
+
+
 def test_a_luma_edge_far_from_the_chroma_one_is_not_taken():
     # a dark mast in front of the body, right below the band: luma steps 3 rows lower than the band ends
     p = _luma_profile(23.3)

@@ -216,8 +216,10 @@ def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: boo
     Luma keeps full resolution through colour denoise and 4:2:0 chroma, which bleed a band's
     colour across its edges, the more in linear light the brighter the other side: into the
     white body always (the chroma edge moves into it by up to a pixel or two: L short, range
-    2-5 % long on such a camera), into a light background too. An inner luma edge is taken when
-    it lies 0-2 px from the chroma one towards the band, the way that bleed moves it; an outer
+    2-5 % long on such a camera; 3-4 px under video coding), into a light background too. An
+    inner luma edge is taken when it lies 0-2 px from the chroma one towards the band, the way
+    that bleed moves it, or farther but short of the middle of the band as ``band_px`` (the
+    chroma's) spans it; an outer
     one within 2 px either way, when the background's luma differs from the band's. Otherwise
     (a mast or a nearer robot's part in front of the body, a background of the band's luma) the
     chroma edge stands.
@@ -249,7 +251,8 @@ def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: boo
     if found is None:
         return None
     shift = s * (edge - found)  # towards the band
-    lo, hi = BLEED_PX if inner else (-OUTER_BLEED_PX, OUTER_BLEED_PX)
+    # an inner edge may lie anywhere the chroma bled over, short of the band's middle (video coding: 3-4 px)
+    lo, hi = (BLEED_PX[0], max(BLEED_PX[1], 0.5 * band_px - 0.5)) if inner else (-OUTER_BLEED_PX, OUTER_BLEED_PX)
     return found if lo <= shift <= hi else None
 
 

@@ -8,9 +8,8 @@ whose outer edge merges with a same-coloured background, or a blue band whose
 lower part a nearer robot hides, is placed from its inner edge and the white
 body's height instead.
 
-Columns (:mod:`.limbs`, re-exported here): a landmark seen whole is measured
-by the saturation-weighted moments of :mod:`.refine`; one cut on a side is
-placed from its other limb.
+Columns (:mod:`.limbs`, re-exported here): a landmark seen whole is measured by the
+saturation-weighted moments of :mod:`.refine`; one cut on a side is placed from its other limb.
 """
 
 from __future__ import annotations
@@ -254,6 +253,8 @@ def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
     bands = []
     for band, down in ((red, True), (blue, False)):
         inner = luma_edge(p, band.inner, down, band_px, True)
+        if inner is None and _height(band, down) > band_px:  # bled 3-4 px (video coding): the band as it bled
+            inner = luma_edge(p, band.inner, down, _height(band, down), True)
         bled = inner is not None and abs(inner - band.inner) >= BLED_PX
         inner = band.inner if inner is None else inner
         if band.merged:
@@ -295,6 +296,5 @@ def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     return dataclasses.replace(blue, merged=True)
 
 
-__all__ = [
-    "CENTROID_SIGMA_X_PX", "Rows", "cut_sides", "measure_columns", "measure_rows", "measure_rows_all", "outline_centre",
-]
+__all__ = ["CENTROID_SIGMA_X_PX", "Rows", "cut_sides", "measure_columns", "measure_rows", "measure_rows_all",
+           "outline_centre"]
