@@ -37,7 +37,7 @@ import numpy as np
 from .._compat import frozen
 from .association import associate, twins
 from .identity_small import update_small
-from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, measurement_variance, predict
+from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, held_at_edges, measurement_variance, predict
 from .types import Landmark
 
 
@@ -170,6 +170,7 @@ def update(
     params: Optional[IdentityParams] = None,
     visible: Optional[Sequence[float]] = None,
     small: bool = True,
+    view_rad: Optional[Tuple[float, float]] = None,
 ) -> Tuple[IdentityState, Identified]:
     """Associate one frame's readings with the tracks; returns the new state and each reading's id and rates.
 
@@ -190,6 +191,9 @@ def update(
     small : bool
         Take :func:`.identity_small.update_small` (floats, not numpy calls) where it
         applies; ``False`` runs the numpy path always (its reference).
+    view_rad : (float, float), optional
+        Bearings of the view's right and left edges: a track predicted out of the view is held
+        at its edge (:func:`.kalman.held_at_edges`), where it will come back into view.
 
     Returns
     -------
@@ -211,6 +215,10 @@ def update(
     params = DEFAULT_PARAMS if params is None else params
     m, n = len(range_m), state.size
     dt = _dt(state, t_s, params)
+    if view_rad is not None and n:
+        held = held_at_edges(state.s, dt, view_rad, params.twin_width_m)
+        state = state if held is state.s else IdentityState(state.ids, held, state.hidden, state.updates,
+                                                             state.next_id, state.t_s)
     if small:  # a few tracks and readings, no two gates overlapping: the same arithmetic on floats
         done = update_small(state.ids, state.s, state.hidden, state.updates, state.next_id, range_m, bearing_rad,
                             range_sigma_m, bearing_sigma_rad, dt, params, visible)

@@ -120,3 +120,30 @@ def correct(s: np.ndarray, z: np.ndarray, r: np.ndarray) -> np.ndarray:
     sn[:, :, VALUE:P00] += gain * innov[:, :, None]
     sn[:, :, P00:] -= gain[:, :, _GAIN_OF] * s[:, :, _COV_OF]
     return sn
+
+
+def held_at_edges(s: np.ndarray, dt_s: float, view_rad: Tuple[float, float], width_m: float) -> np.ndarray:
+    """Tracks about to be predicted past the view's edge held at that edge (packed ``s``, before :func:`predict`).
+
+    A landmark whose prediction leaves the view (bearing beyond ``view_rad`` =
+    ``(right edge, left edge)``, radians, positive left) while moving outwards can no
+    longer be seen, so nothing will correct the prediction: its constant velocity
+    would carry it on outwards, while the robot beyond the edge may stop or turn
+    back, and when it comes into view again it does so at that edge. Such a track is
+    put at the edge with no bearing rate (value and rate uncorrelated), its bearing
+    variance at least a landmark's width (``width_m`` at its range) squared: where,
+    along the edge, it shows again. Its range and the rate's variance are kept.
+    Returns ``s`` itself when no track is held, else a changed copy.
+    """
+    lo, hi = view_rad
+    out = None
+    for i, ((rng, _, _, _, _), (b, v, p00, _, _)) in enumerate(s.tolist()):
+        nxt = b + dt_s * v
+        if not ((nxt > hi and v > 0.0) or (nxt < lo and v < 0.0)):
+            continue
+        if out is None:
+            out = s.copy()
+        ch = out[i, BEARING]
+        ch[VALUE], ch[RATE], ch[P01] = hi if v > 0.0 else lo, 0.0, 0.0
+        ch[P00] = max(p00, (width_m / max(rng, 0.05)) ** 2)
+    return s if out is None else out

@@ -94,6 +94,12 @@ def paper_reading(
     return d_v / math.cos(theta), theta, d_v, d_h, l_px
 
 
+def view_edges_rad(cam: CameraIntrinsics) -> Tuple[float, float]:
+    """Bearings (radians, positive left) of the frame's right and left edges on its centre row."""
+    (xl, _), (xr, _) = normalised(np.array([[-0.5, cam.cy_px], [cam.width_px - 0.5, cam.cy_px]]), cam)
+    return math.atan(-xr), math.atan(-xl)
+
+
 def reading(
     red_xy: XY, blue_xy: XY, cam: CameraIntrinsics, model: ModelParams, geometry: LandmarkGeometry
 ) -> Tuple[float, float, float, float, float]:

@@ -26,7 +26,7 @@ from .detect import BandCentroids, detect_paper, downscale, drop_stacked, refine
 from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
-from .model import in_envelope, reading
+from .model import in_envelope, reading, view_edges_rad
 from .newcomers import SideCounts, SideView, came_in, side_view
 from .pairing import PairingLimits
 from .params import PipelineParams
@@ -76,6 +76,7 @@ class Pipeline:
         self.ids = (track is not False) if ids is None else ids
         self.limits = PairingLimits()
         self._cams: Dict[Tuple[int, int], Tuple[CameraIntrinsics, int]] = {}
+        self._views: Dict[Tuple[int, int], Tuple[float, float]] = {}
         self._identity: IdentityState = empty_state(first_track_id)
         self.reset()
 
@@ -109,6 +110,7 @@ class Pipeline:
             # the envelope only flags readings: the filter keeps bands out to SEARCH_RANGE_M whatever calibrate wrote
             band_px = cam.fy_px * self.params.landmark.band_height_m / SEARCH_RANGE_M / self.params.detection.downscale
             self._cams[key] = (cam, band_preserving_ksize(self.params.detection.median_ksize, band_px))
+            self._views[key] = view_edges_rad(cam)  # the identity filter holds tracks that leave the view there
         return self._cams[key]
 
     def process(
@@ -146,15 +148,17 @@ class Pipeline:
             # landmarks crossing, one coming out from behind another, or one coming into view: a full scan
             if (tracking and not crossing([*self._tracks, *tracks_of(self._hidden)])
                     and not came_in(self._sides_now(bgr), self._sides)):
-                self._tracks, self._lost = step(
-                    bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px
-                )
-                lost = bool(self._lost)
-                # a lost landmark may be just outside its window: scan the whole frame next time
-                self._since_scan = det.full_scan_every if lost else self._since_scan + 1
-                found = [t.bands for t in self._tracks]
-                tracked = True
+                kept, lost = step(bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px)
+                # a landmark lost in its window (gone astray, half hidden, changed): this frame is scanned
+                # whole, from the tracks as they were, as if its scan had been due; its reading is not missed
+                if not lost:
+                    self._tracks, self._lost = kept, lost
+                    self._since_scan += 1
+                    found = [t.bands for t in self._tracks]
+                    tracked = True
             else:
+                lost = []
+            if not tracked:
                 yuv = search if search is not None and det.downscale == 2 and search.y.shape == (h, w) else None
                 small = downscale(bgr, det.downscale) if yuv is None else None
                 y_half = half_luma(yuv.y) if yuv is not None else None
@@ -189,7 +193,8 @@ class Pipeline:
                 if self.track:  # what the sides hold now, the landmarks found blanked (core/newcomers.py)
                     self._side_view = None
                     self._sides = self._sides_now(bgr)
-                self._since_scan = 0
+                # what lost a landmark (one passing behind another, coming out) is still under way: the next frame too
+                self._since_scan = det.full_scan_every - 1 if lost else 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M
         readings = sorted((r for r in (self._reading(c, cam, bgr) for c in found) if 0 < r[0] <= MAX_RANGE_M),
@@ -200,6 +205,7 @@ class Pipeline:
         self._identity, out = update(
             self._identity, [r[0] for r in readings], [r[1] for r in readings], [r[10] for r in readings],
             [r[11] for r in readings], t_s, self.params.identity, [r[12] for r in readings],
+            view_rad=self._views[(w, h)],
         )
         landmarks = tuple(
             Landmark(*r, int(tid), None if rr != rr else float(rr), None if br != br else float(br))  # NaN: no rate yet
