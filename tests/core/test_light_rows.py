@@ -38,3 +38,12 @@ def test_a_one_row_fringe_at_a_bright_background_does_not_seed_the_band():
     edges = _band(p2d, p2d.mean(axis=1), 32.5, 25.0, 67.0, True)
     assert edges is not None
     assert edges.centre == pytest.approx(32.5, abs=0.8)  # the fringe itself biases the outer edge a little
+
+
+
+def test_a_region_with_no_excess_is_no_band_even_where_the_white_body_reads_lower():
+    # an all-red room: the blue "band" rows read -0.0024 (no blue at all), the body above -0.008, and the
+    # tile ends right after the band's core (the frame's edge): nothing to measure, and no division by zero
+    p2d = np.full((15, 6), -0.008, np.float32)
+    p2d[11:] = -0.0024
+    assert band_rows(p2d, 13, 20, False, 8, 20) is None

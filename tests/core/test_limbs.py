@@ -116,3 +116,36 @@ def test_where_the_chroma_is_blurred_more_than_the_luma_the_chromaticity_edge_st
     q = e / s
     level = float(np.median(q[5:10]))
     assert limb(q, 7, 39, level, (e, s)) == limb(q, 7, 39, level)
+
+
+@pytest.mark.parametrize("marked", [(True, True), (False, True), (True, False)])
+def test_beside_a_nearer_landmark_the_far_side_is_the_limb_whatever_the_search_marked_there(marked):
+    # a nearer landmark's white body hides everything left of column 50 (it falls off like a limb there too);
+    # the search marked a side cut (a band of this one ran on into a same-coloured wall, or the nearer
+    # landmark beside it): the right limb at 74.3 places it, never the nearer landmark's edge
+    import dataclasses
+
+    from rangebearing.core.structure import occluded_sides
+
+    img = _frame(40.3, 74.3, (50, (0.85, 0.85, 0.85)))
+    c = Candidate((50, 20, 24, 15), (50, 76, 24, 15), 40.0, False, False, *marked, 0.7)
+    near = Candidate((10, 10, 40, 22), (10, 100, 40, 22), 60.0, False, False, False, False, 1.0)
+    c = occluded_sides([c, near], 2)[0]
+    assert c.occluded == "left"
+    x, _ = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(74.3, True), abs=0.05)
+    if marked[1]:  # without the nearer landmark known: no limb (both sides fall off 24 px apart), or the wrong one
+        got = measure_columns(img, dataclasses.replace(c, occluded=""), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+        assert got is None or abs(got[0] - _centre(74.3, True)) > 1.0
+
+
+def test_beside_a_nearer_landmark_a_far_side_whose_band_runs_on_past_the_run_gives_no_limb():
+    # the far side marked cut, and the band's colour does run on there (a red box right of column 78 at the
+    # red band's rows, beyond the run's end at 74): that limb does not end the run, so the moments stand
+    img = _frame(40.3, 74.3, (50, (0.85, 0.85, 0.85)))
+    lin = (img.astype(np.float64) / 255.0) ** 2.2
+    lin[20:35, 74:110] = (0.06, 0.07, 0.70)  # BGR: red
+    img = np.round(255.0 * lin ** (1 / 2.2)).astype(np.uint8)
+    c = Candidate((50, 20, 24, 15), (50, 76, 24, 15), 40.0, False, False, True, True, 0.7, occluded="left")
+    got = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert got is None or abs(got[0] - _centre(74.3, True)) < 0.3

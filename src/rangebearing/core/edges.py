@@ -122,7 +122,9 @@ def band_rows(
     white_end = min(n - 1, max(0, white_end))
     outer_end = min(n - 1, max(0, outer_end))
     w_bg = _level_beyond(p, white_end, inner_down)
-    if level - w_bg <= step_floor(level):  # no colour step at the white body: not a band
+    # no paint's excess, or no colour step at the white body: not a band (with level > 0 the outer step
+    # below is either merged or at least half the level, so neither edge divides by zero)
+    if not level > 0.0 or level - w_bg <= step_floor(level):
         return None
     if inner_down:
         inner = edge_down(p, mid, white_end, level, w_bg)

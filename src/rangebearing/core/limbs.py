@@ -88,7 +88,9 @@ def measure_columns(
     background like a limb (the other runs on into a same-coloured band in front),
     from that one; where both do and they lie a whole outline apart, from their
     midpoint. Where both fall off closer together (something of another colour in
-    front on one side) the side is not known: the moments stand. A limb found farther than
+    front on one side) the side is not known: the moments stand. Beside a nearer landmark
+    (``occluded``) the side away from it is the limb, whatever the structure search marked
+    there. A limb found farther than
     ``RUN_END_PX`` + ``RUN_END_SHARE`` of the outline from the end of the run the structure
     search saw on its side is not taken (a background of the band's colour carried the band on).
     """
@@ -96,6 +98,13 @@ def measure_columns(
     if not (cut_left or cut_right):
         return None
     rx, _, rw, _ = c.red_bbox_px
+    ends = False  # the limb must end the run the structure search saw on its side
+    far_at_edge = rx + rw >= bgr.shape[1] - FRAME_EDGE_PX if c.occluded == "left" else rx <= FRAME_EDGE_PX
+    if c.occluded and not far_at_edge:
+        # a nearer landmark hides one side: the other is the limb, where it ends the run (marked cut there, the
+        # run's band met a same-coloured background; a band of the colour that carried it on would not end it)
+        ends = c.cut_right if c.occluded == "left" else c.cut_left
+        cut_left, cut_right = c.occluded == "left", c.occluded == "right"
     if cut_left and cut_right and not (c.cut_left and c.cut_right and c.visible < HIDDEN_BELOW):
         return None  # whole, or the frame's edge cuts a side: no limb there, none known on the other
     white_m = geometry.height_m - 2 * geometry.band_height_m
@@ -105,8 +114,8 @@ def measure_columns(
     both = cut_left and cut_right
     edge_r = _limb_edge(bgr, c, gains, geometry, rows, half, True) if both or not cut_right else None
     edge_l = _limb_edge(bgr, c, gains, geometry, rows, half, False) if both or not cut_left else None
-    if both:  # a side's limb, where it has one, ends the run the structure search saw there
-        tol = RUN_END_PX + RUN_END_SHARE * 2 * half
+    tol = RUN_END_PX + RUN_END_SHARE * 2 * half
+    if both or ends:  # a side's limb, where it has one, ends the run the structure search saw there
         edge_r = edge_r if edge_r is not None and abs(edge_r - (rx + rw)) <= tol else None
         edge_l = edge_l if edge_l is not None and abs(edge_l - rx) <= tol else None
     if edge_r is not None and edge_l is not None:  # both natural: the outline's centre is their midpoint

@@ -70,6 +70,7 @@ class Candidate:
     visible: float
     hidden_band: str = ""  # "red"/"blue": seen in fewer of the columns (partly hidden), its moments no column cue
     body_cols_px: Optional[Tuple[int, int]] = None  # [x0, x1) where the white body shows, when only part of it does
+    occluded: str = ""  # "left"/"right": a nearer landmark stands right beside it there and hides that side
 
 
 def _pairable(reds: np.ndarray, blues: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -265,16 +266,21 @@ def occluded_sides(cands: List[Candidate], scale: int) -> List[Candidate]:
     out = []
     for c in cands:
         x0, x1 = c.red_bbox_px[0], c.red_bbox_px[0] + c.red_bbox_px[2]
-        left, right = c.cut_left, c.cut_right
-        if c.visible < 0.9 and not (left or right):
+        near_l = near_r = False
+        if c.visible < 0.9:
             for o in cands:
                 if o.white_px <= c.white_px:
                     continue
                 ox0, ox1 = o.red_bbox_px[0], o.red_bbox_px[0] + o.red_bbox_px[2]
-                left = left or abs(ox1 - x0) <= 2 * scale
-                right = right or abs(ox0 - x1) <= 2 * scale
-        out.append(c if (left, right) == (c.cut_left, c.cut_right) else dataclasses.replace(c, cut_left=left,
-                                                                                           cut_right=right))
+                near_l = near_l or abs(ox1 - x0) <= 2 * scale
+                near_r = near_r or abs(ox0 - x1) <= 2 * scale
+        left, right = (near_l, near_r) if not (c.cut_left or c.cut_right) else (c.cut_left, c.cut_right)
+        # the side a nearer landmark hides, even where the run's other end was marked cut too (its band runs on
+        # into a same-coloured wall): that end may still be a limb (.limbs.measure_columns)
+        occluded = "left" if near_l and not near_r else "right" if near_r and not near_l else ""
+        if (left, right, occluded) != (c.cut_left, c.cut_right, c.occluded):
+            c = dataclasses.replace(c, cut_left=left, cut_right=right, occluded=occluded)
+        out.append(c)
     return out
 
 
