@@ -44,7 +44,7 @@ from rangebearing.core import uncertainty as u
 from rangebearing.evaluation.match import match_frame
 from rangebearing.sources.recorded import iter_recorded
 
-RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "fit": ("FIT_SPREAD",),
+RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "fit": ("FIT_SPREAD",), "moment": ("MOMENT_PX",),
                "merged": ("MERGED_PX",), "blur": ("CHROMA_SHARE",),
                "hidden": ("HIDDEN_SHARE_L",), "cut": ("CUT_SHARE_L", "SPLIT_SHARE_L"),
                "floor": ("EDGE_FLOOR_PX", "MODEL_FLOOR")}

@@ -26,10 +26,14 @@ def test_row_spread_is_half_the_disagreement_of_the_two_estimators_per_band():
 def test_a_row_from_its_edges_alone_has_its_own_share_of_the_disagreement():
     both = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False)
     fits = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False, True, True)
-    assert fits == pytest.approx(math.hypot(0.4 * u.FIT_SPREAD, 0.3 * u.FIT_SPREAD))
+    edges_only = [u.FIT_SPREAD * math.sqrt(d * d - u.MOMENT_PX**2) for d in (0.4, 0.3)]
+    assert fits == pytest.approx(math.hypot(*edges_only))
     assert fits < both  # the mean's error is half the disagreement; the edges' row errs less
     one = u.row_spread_px(10.4, 10.0, False, 49.7, 50.0, False, True, False)
-    assert one == pytest.approx(math.hypot(0.4 * u.FIT_SPREAD, 0.15))
+    assert one == pytest.approx(math.hypot(edges_only[0], 0.15))
+    # the moment's own error does not reach a row placed from the edges: a disagreement within it is none
+    assert u.row_spread_px(10.0 + 0.9 * u.MOMENT_PX, 10.0, False, 50.0, 50.0, False, True, True) == 0.0
+    assert u.row_spread_px(10.0 + 0.9 * u.MOMENT_PX, 10.0, False, 50.0, 50.0, False) > 0.0  # the mean has it
     # a merged band is placed from its inner edge whether or not it "fits"
     assert u.row_spread_px(30.0, 10.0, True, 50.0, 50.0, False, True, True) == pytest.approx(u.MERGED_PX)
 

@@ -56,11 +56,12 @@ from .edges import excess_luma, mean_along
 from .types import LandmarkGeometry
 
 # range: terms of the band spacing's error (px), each in quadrature
-NOISE_SHARE = 0.5  # column-scatter standard error of the inner edges → the spacing
-SPREAD_SHARE = 1.75  # share of the row estimators' disagreement (row_spread_px) that is error
+NOISE_SHARE = 0.55  # column-scatter standard error of the inner edges → the spacing
+SPREAD_SHARE = 2.5  # share of the row estimators' disagreement (row_spread_px) that is error
 FIT_SPREAD = 0.21  # share of |moment − edge| a row from its edges alone errs by (the mean of both: 0.5)
+MOMENT_PX = 0.22  # the chroma moment's own error (px): the part of |moment − edge| a row from its edges lacks
 EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the outline's curve
-CHROMA_SHARE = 0.11  # per band centre, share of the colour's own blur (chroma_blur_px)
+CHROMA_SHARE = 0.14  # per band centre, share of the colour's own blur (chroma_blur_px)
 MERGED_PX = 1.42  # a band placed from its inner edge and the white height (heights on a curved surface)
 HIDDEN_SHARE_L = 0.138  # share of L per unit of hidden share (the edges' curve over the visible part)
 SPLIT_SHARE_L = 0.00596  # share of L: a landmark cut on both sides (split between neighbours)
@@ -187,14 +188,22 @@ def row_spread_px(
     A band whose row is the mean of its moment and its edges' row contributes
     ``(moment − edge)²/4``; a band placed from its edges alone (``*_fits``: its edges span
     the landmark's band height, :meth:`.measure.Rows.band_y`) errs by less than that mean,
-    ``(FIT_SPREAD · (moment − edge))²``; a merged band, whose moment is not its own,
-    contributes ``MERGED_PX²`` instead.
+    ``FIT_SPREAD² · max(0, (moment − edge)² − MOMENT_PX²)``: the disagreement's square is the
+    two estimators' errors' squares added, and the moment's own (its mask's sampling of a
+    curved band, shading within it: ``MOMENT_PX``, about what a clean render of a lone landmark
+    shows, where the edges are right to their noise) does not reach a row placed without it.
+    A merged band, whose moment is not its own, contributes ``MERGED_PX²`` instead.
     """
     terms = []
     for moment, edge, merged, fits in ((moment_red_px, edge_red_px, red_merged, red_fits),
                                        (moment_blue_px, edge_blue_px, blue_merged, blue_fits)):
-        share = FIT_SPREAD if fits else 0.5
-        terms.append(MERGED_PX**2 if merged else (share * (moment - edge)) ** 2)
+        d2 = (moment - edge) ** 2
+        if merged:
+            terms.append(MERGED_PX**2)
+        elif fits:
+            terms.append(FIT_SPREAD**2 * max(0.0, d2 - MOMENT_PX**2))
+        else:
+            terms.append(0.25 * d2)
     return math.sqrt(terms[0] + terms[1])
 
 
