@@ -83,7 +83,10 @@ def associate(s: np.ndarray, updates: np.ndarray, z: np.ndarray, r: np.ndarray, 
             b = z[cols, BEARING]
             side = (b - s[rows, BEARING, VALUE])[None, :] * (b[None, :] - s[free, BEARING, VALUE][:, None])
             trust = ~(((side < 0) & gated[free][:, cols]).any(axis=0) & (outlier | (seen[cols] < 1.0)))
-    return rows, cols, noise[outlier.astype(np.intp), cols], trust
+    # a reading seen whole far from its track is the robot manoeuvring (a sudden stop or turn the filter's
+    # acceleration bound did not foresee), not a bad reading: it updates with its own noise, so the track
+    # follows instead of falling behind, reading after reading, until it loses its robot
+    return rows, cols, noise[(outlier & (seen[cols] < 1.0)).astype(np.intp), cols], trust
 
 
 def twins(det_row: np.ndarray, z: np.ndarray, cols: np.ndarray, params: IdentityParams) -> None:

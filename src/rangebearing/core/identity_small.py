@@ -111,7 +111,7 @@ def update_small(
         if len(pairs) > 1 and (len({p[0] for p in pairs}) < len(pairs) or len({p[1] for p in pairs}) < len(pairs)):
             return None  # gates overlap: the numpy path chooses (association.assign_gated)
         for i, j, outlier in pairs:
-            _corrected(s[i], z[j], out_r[j] if outlier else r[j])
+            _corrected(s[i], z[j], out_r[j] if outlier and vis[j] < 1.0 else r[j])  # (association.associate)
             hidden[i] = 0
             updates[i] += 1
             det_row[j] = i
