@@ -88,3 +88,30 @@ def both_outside(red: np.ndarray, blue: np.ndarray, boxes: Sequence[Box], scale:
     """Whether both masks (0/255, downscaled by ``scale``) have a set pixel outside every box
     (:func:`blanked`): only then can a landmark stand wholly apart from those boxes."""
     return bool(cv2.countNonZero(blanked(red, boxes, scale))) and bool(cv2.countNonZero(blanked(blue, boxes, scale)))
+
+
+def _mask_rects(boxes: Sequence[Box], scale: int) -> np.ndarray:
+    """(N, 4) ``r0, r1, c0, c1`` mask rows and columns ``[r0, r1) × [c0, c1)`` that :func:`blanked` clears."""
+    return np.asarray([(max(0, y0 // scale - 1), max(0, -(-y1 // scale) + 1),
+                        max(0, x0 // scale - 1), max(0, -(-x1 // scale) + 1)) for x0, y0, x1, y1 in boxes], np.int64)
+
+
+def none_apart_filtered(red: np.ndarray, blue: np.ndarray, boxes: Sequence[Box], scale: int, ksize: int) -> bool:
+    """Whether :func:`band_masks` of the raw class masks ``red``, ``blue`` would certainly fail
+    :func:`both_outside` for ``boxes``: judged on the raw masks, without filtering them.
+
+    :func:`regrow` adds only raw pixels, and a majority window centred outside one
+    cleared rectangle holds at most ``k·(k//2)`` pixels of it (fewer than half, also with
+    the replicated border): so when a raw mask has nothing outside the rectangles, neither
+    has its filtered mask, provided no window can reach two rectangles (their ``k//2``
+    neighbourhoods are disjoint; else ``False``: filter and look).
+    """
+    half = ksize // 2 if ksize > 1 else 0
+    if len(boxes) > 1:
+        r = _mask_rects(boxes, scale)
+        i, j = np.triu_indices(len(r), 1)
+        near = ((r[i, 0] < r[j, 1] + 2 * half) & (r[j, 0] < r[i, 1] + 2 * half)
+                & (r[i, 2] < r[j, 3] + 2 * half) & (r[j, 2] < r[i, 3] + 2 * half))
+        if near.any():
+            return False
+    return not both_outside(red, blue, boxes, scale)

@@ -28,10 +28,11 @@ import numpy as np
 from .._compat import frozen
 from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
-from .denoise import Box, band_masks, median_filter
+from .denoise import Box, band_masks, median_filter, none_apart_filtered
 from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
+from .search_image import SearchImage
 from .structure import Candidate, Found, search, search_apart
 from .types import XY, BBox, LandmarkGeometry, union
 from .uncertainty import row_spread_px, silhouette_share
@@ -97,26 +98,30 @@ WHITE_SLACK_PX = 2.0
 
 def search_candidates(
     small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: int, geometry: LandmarkGeometry,
-    relaxed: Optional[Sequence[Box]] = None, hsv_of: Optional[Dict[Gains, np.ndarray]] = None,
+    relaxed: Optional[Sequence[Box]] = None, hsv_of: Optional[Dict[Gains, SearchImage]] = None,
 ) -> Found:
     """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
     band-coloured region (:func:`.structure.search`). ``relaxed``: the second look
     (:func:`.balance.second_look`) with lower saturation and value floors (:func:`.color.relaxed_floors`),
     given the ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found: it is not
-    searched when the masks hold no red or no blue outside them (a landmark apart from them has both).
-    ``hsv_of``: the frame's HSV images by gains, kept for the searches after (the second look's)."""
-    hsv = None if hsv_of is None else hsv_of.get(gains)
-    if hsv is None:
-        hsv = to_hsv(apply_gains(small, gains))
+    searched when the masks hold no red or no blue outside them (a landmark apart from them has both),
+    judged before the band filter where that is exact (:func:`.denoise.none_apart_filtered`).
+    ``hsv_of``: the frame's :class:`.search_image.SearchImage` by gains, kept for the searches after
+    (the second look's)."""
+    img = None if hsv_of is None else hsv_of.get(gains)
+    if img is None:
+        img = SearchImage(small, gains)
         if hsv_of is not None:
-            hsv_of[gains] = hsv
+            hsv_of[gains] = img
     s_min, v_min = (cfg.s_min, cfg.v_min) if relaxed is None else relaxed_floors(cfg.s_min, cfg.v_min)
-    red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, _clipped(small, gains))
+    red, blue = img.class_masks(cfg, s_min, v_min)
+    if relaxed is not None and none_apart_filtered(red, blue, relaxed, cfg.downscale, ksize):
+        return Found([], lambda: True)  # as search_apart says of filtered masks with nothing apart
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / (cfg.downscale * cfg.downscale)))
     if relaxed is not None:
-        return search_apart(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, relaxed)
-    return search(red, blue, hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
+        return search_apart(red, blue, img.hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area, relaxed)
+    return search(red, blue, img.hsv, cfg.downscale, geometry, cfg.max_landmarks, min_area)
 
 
 def refine(

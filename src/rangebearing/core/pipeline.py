@@ -32,6 +32,7 @@ from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
 from .scans import crossing, rescanned
+from .search_image import SearchImage
 from .structure import Found
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
@@ -164,7 +165,7 @@ class Pipeline:
                 y_half = half_luma(yuv.y) if yuv is not None else None
                 geometry = self.params.landmark
 
-                hsv_of: Dict[Gains, np.ndarray] = {}
+                hsv_of: Dict[Gains, SearchImage] = {}
 
                 def find(gains: Gains, relaxed: Optional[List[Box]] = None) -> Found:
                     if yuv is None:

@@ -1,0 +1,48 @@
+"""The downscaled frame as the structure search reads it under one balance, each view made once per frame.
+
+A full scan searches the frame under its balance and then takes a second look at
+lower colour floors (:func:`.balance.second_look`) under the same gains: both read the
+same HSV image, its channels, the red and blue hue masks and the clipped pixels, which
+differ only in their saturation and value gate. :class:`SearchImage` keeps them, so the
+second look costs one gate and two ``and``\\ s instead of a second conversion.
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Tuple
+
+import cv2
+import numpy as np
+
+from .color import Gains, apply_gains, clipped_mask, hue_in, sv_gate, to_hsv
+from .params import DetectionParams
+
+
+class SearchImage:
+    """The views of one downscaled BGR frame (``small``, uint8) under ``gains``, made on first use."""
+
+    __slots__ = ("_clipped", "_hsv_split", "_hues", "gains", "hsv", "small")
+
+    def __init__(self, small: np.ndarray, gains: Gains) -> None:
+        self.small, self.gains = small, gains
+        self.hsv: np.ndarray = to_hsv(apply_gains(small, gains))
+        self._hsv_split: Optional[Tuple[np.ndarray, ...]] = None
+        self._hues: Optional[Tuple[np.ndarray, np.ndarray]] = None
+        self._clipped: Optional[Tuple[Optional[np.ndarray]]] = None
+
+    def clipped(self) -> Optional[np.ndarray]:
+        """Pixels clipped before the gains, when a gain below one may have hidden it (else ``None``)."""
+        if self._clipped is None:
+            self._clipped = (clipped_mask(self.small) if min(self.gains) < 0.98 else None,)
+        return self._clipped[0]
+
+    def class_masks(self, cfg: DetectionParams, s_min: int, v_min: int) -> Tuple[np.ndarray, np.ndarray]:
+        """:func:`.color.class_masks` of the HSV image at these floors (0/255 uint8; the same arrays' values)."""
+        if self._hsv_split is None:
+            self._hsv_split = tuple(cv2.split(self.hsv))
+            h = self._hsv_split[0]
+            self._hues = (hue_in(h, cfg.red_hue), hue_in(h, cfg.blue_hue))
+        _, s, v = self._hsv_split
+        red_h, blue_h = self._hues  # type: ignore[misc]
+        sv = sv_gate(s, v, s_min, v_min, self.clipped())
+        return cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv)
