@@ -96,3 +96,22 @@ def test_a_band_clipped_before_the_gains_stays_clipped():
 def test_only_pixels_with_a_channel_at_250_or_more_are_clipped():
     frame = np.array([[(150, 160, 252), (249, 249, 249), (250, 10, 10), (0, 0, 0)]], np.uint8)
     assert clipped_mask(frame).tolist() == [[255, 0, 255, 0]]
+
+
+@pytest.mark.parametrize("gains", [(1.0, 1.0, 1.0), (1.3, 1.0, 0.8)])
+def test_search_image_class_masks_are_color_class_masks(gains):
+    from rangebearing.core.params import DetectionParams
+    from rangebearing.core.search_image import SearchImage
+
+    rng = np.random.default_rng(7)
+    small = rng.integers(0, 256, (40, 60, 3), dtype=np.uint8)
+    small[:5] = 255  # clipped rows
+    cfg = DetectionParams()
+    img = SearchImage(small, gains)
+    hsv = to_hsv(apply_gains(small, gains))
+    clip = clipped_mask(small) if min(gains) < 0.98 else None
+    assert np.array_equal(img.hsv, hsv)
+    for s_min, v_min in ((cfg.s_min, cfg.v_min), (60, 30), (cfg.s_min, cfg.v_min)):  # again: the cached views
+        got = img.class_masks(cfg, s_min, v_min)
+        want = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, clip)
+        assert all(np.array_equal(g, w) for g, w in zip(got, want))

@@ -9,6 +9,7 @@ from rangebearing.core.denoise import (
     both_outside,
     majority_filter,
     median_filter,
+    none_apart_filtered,
     regrow,
 )
 
@@ -98,3 +99,42 @@ def test_both_outside_needs_red_and_blue_beyond_every_box():
     assert not both_outside(red, blue, box, 2)  # red beyond it, but no blue
     blue[12, 25] = 255
     assert both_outside(red, blue, box, 2) and both_outside(red, blue, [], 2)
+
+
+@pytest.mark.parametrize("k", [3, 5, 7])
+def test_none_apart_filtered_is_never_wrong_about_the_filtered_masks(k):
+    # dense blobs inside boxes and, sometimes, specks or blobs outside: whenever the raw masks say
+    # "nothing apart", the filtered masks must say so too (the second look then skips its filter)
+    rng = np.random.default_rng(100 + k)
+    said = 0
+    for trial in range(300):
+        red = np.zeros((60, 80), np.uint8)
+        blue = np.zeros_like(red)
+        n = int(rng.integers(1, 4))
+        boxes = []
+        for _ in range(n):
+            x0, y0 = int(rng.integers(0, 140)), int(rng.integers(0, 100))
+            boxes.append((x0, y0, x0 + int(rng.integers(4, 30)), y0 + int(rng.integers(4, 30))))
+        for mask in (red, blue):
+            for x0, y0, x1, y1 in boxes:  # fill each box (mask pixels, as blanked() clears them) densely
+                r0, r1, c0, c1 = max(0, y0 // 2 - 1), -(-y1 // 2) + 1, max(0, x0 // 2 - 1), -(-x1 // 2) + 1
+                mask[r0:r1, c0:c1] = (rng.random(mask[r0:r1, c0:c1].shape) < 0.9) * 255
+            if trial % 3 == 0:
+                mask[int(rng.integers(0, 60)), int(rng.integers(0, 80))] = 255
+        if none_apart_filtered(red, blue, boxes, 2, k):
+            said += 1
+            assert not both_outside(*band_masks(red, blue, k), boxes, 2)
+    assert said > 50  # the gate does say so, often
+
+
+def test_none_apart_filtered_filters_when_two_boxes_are_within_one_window():
+    # two dense boxes one mask column apart: the majority window fills the column between them
+    red = np.zeros((20, 40), np.uint8)
+    red[4:12, 4:10] = 255
+    red[4:12, 11:17] = 255
+    boxes = [(10, 10, 18, 22), (24, 10, 32, 22)]  # mask columns 4-9 and 11-16 once grown by one
+    assert not both_outside(red, red, boxes, 2)  # the raw masks hold nothing outside the boxes ...
+    assert both_outside(*band_masks(red, red, 3), boxes, 2)  # ... the filtered ones do: column 10
+    assert not none_apart_filtered(red, red, boxes, 2, 3)  # too close to judge on the raw masks
+    far = [(10, 10, 18, 22), (40, 10, 48, 22)]
+    assert none_apart_filtered(np.zeros_like(red), red, far, 2, 3)
