@@ -124,3 +124,12 @@ def test_a_neighbouring_band_inside_the_window_does_not_pull_the_centroid():
     fixes = measure_bands(img, [alone, other], [True, True], [(12, 4), (12, 4)], CFG, (1.0, 1.0, 1.0))
     assert fixes[0].xy_px == pytest.approx((34.5, 24.5), abs=0.05)
     assert fixes[1].xy_px == pytest.approx((70.5, 24.5), abs=0.05)
+
+
+def test_tile_sums_are_numpys_exact_integer_sums():
+    from rangebearing.core.refine import _tile_sums
+
+    rng = np.random.default_rng(3)
+    for n, h, w in ((1, 3, 4), (5, 17, 23), (2, 120, 200)):
+        a = rng.integers(0, 256, (n * h, w), dtype=np.uint8)
+        assert np.array_equal(_tile_sums(a, n), a.reshape(n, -1).sum(axis=1, dtype=np.int64))

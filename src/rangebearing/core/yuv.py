@@ -30,7 +30,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
-from .denoise import Box, band_masks
+from .denoise import Box, band_masks, none_apart_filtered
 from .params import DetectionParams
 from .structure import Found, search, search_apart
 from .types import LandmarkGeometry
@@ -263,6 +263,8 @@ def yuv_search(
         s_min, v_min = relaxed_floors(cfg.s_min, cfg.v_min)
         cfg = dataclasses.replace(cfg, s_min=s_min, v_min=v_min)
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
+    if relaxed is not None and none_apart_filtered(red, blue, relaxed, 2, ksize):
+        return Found([], lambda: True)  # as search_apart says of filtered masks with nothing apart
     red, blue = band_masks(red, blue, ksize)
     min_area = max(2, int(cfg.min_band_px * cfg.min_band_px / 4))
     hsv = WindowHsv(y_half, yuv, gains)
