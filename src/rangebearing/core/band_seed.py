@@ -44,11 +44,11 @@ def seeded_band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: 
     k = min(k, len(prof))  # a tile cut short at the frame edge: np.convolve "same" returns the longer length
     smooth = np.convolve(prof, box_kernel(k), mode="same") if k > 1 else prof
     top = int(np.argmax(smooth))
-    strong = prof >= 0.5 * smooth[top]
+    strong = (prof >= 0.5 * smooth[top]).tolist()  # Python bools: the walks below index them one by one
     first, last = top, top  # the band's rows: the run of strong colour around the strongest row
     while first > 0 and strong[first - 1]:
         first -= 1
-    while last < len(prof) - 1 and strong[last + 1]:
+    while last < len(strong) - 1 and strong[last + 1]:
         last += 1
     half = max(0, int(0.5 * hb - 1.5))
     into_white = round(min(0.5 * hb + 4, 0.5 * hb + 0.4 * hw))  # past the blurred edge, no farther

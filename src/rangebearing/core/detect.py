@@ -263,21 +263,22 @@ def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
     of its red band over its body over its robot's camera board in front, read
     as a far landmark's red, white and blue).
     """
+    # each landmark's spacing, box and width once (properties), then the pairs on plain tuples
+    facts = [(c, c.blue_xy_px[1] - c.red_xy_px[1], c.bbox_px, c.width_px) for c in found]
     out = []
-    for c in found:
-        l_c = c.blue_xy_px[1] - c.red_xy_px[1]
+    for c, l_c, box_c, w_c in facts:
         below = any(
             o is not c
-            and l_c <= STACK_SIZE * (o.blue_xy_px[1] - o.red_xy_px[1])
+            and l_c <= STACK_SIZE * l_o
             and c.red_xy_px[1] > o.blue_xy_px[1]
-            and abs(c.red_xy_px[0] - o.red_xy_px[0]) <= STACK_REACH * max(c.width_px, o.width_px)
-            for o in found
+            and abs(c.red_xy_px[0] - o.red_xy_px[0]) <= STACK_REACH * max(w_c, w_o)
+            for o, l_o, _, w_o in facts
         )
         inside = any(
             o is not c
-            and NEST_SIZE * l_c <= o.blue_xy_px[1] - o.red_xy_px[1]
-            and _share_inside(c.bbox_px, o.bbox_px) >= NEST_SHARE
-            for o in found
+            and NEST_SIZE * l_c <= l_o
+            and _share_inside(box_c, box_o) >= NEST_SHARE
+            for o, l_o, box_o, _ in facts
         )
         if not (below or inside):
             out.append(c)
