@@ -62,6 +62,7 @@ from __future__ import annotations
 import math
 from typing import List, Optional, Sequence, Tuple
 
+import cv2
 import numpy as np
 
 from .detect import BandCentroids
@@ -105,8 +106,9 @@ def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
     sub = bgr[r0:r1:rs, c0:c1:cs]
     n = sub.shape[0] * sub.shape[1]
-    # the channel sums are exact integers: the mean's values (np.mean's float sum) in three Python floats
-    return [(total / n / 255.0) ** 2.2 for total in np.add.reduce(sub, axis=(0, 1), dtype=np.int64).tolist()]
+    # the channel sums are exact integers (as floats: below 2**53): the mean's values (np.mean's float sum) in
+    # three Python floats; OpenCV sums a strided region several times faster than numpy's uint8 → int64 reduction
+    return [(total / n / 255.0) ** 2.2 for total in cv2.sumElems(sub)[:3]]
 
 
 def _same(a: Optional[List[float]], b: Optional[List[float]]) -> bool:
