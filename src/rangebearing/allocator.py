@@ -36,3 +36,17 @@ def keep_freed_buffers(keep_b: int = KEEP_B) -> bool:
     mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
     mallopt.restype = ctypes.c_int
     return mallopt(M_MMAP_THRESHOLD, keep_b) == 1 and mallopt(M_TRIM_THRESHOLD, 2 * keep_b) == 1
+
+
+def one_worker() -> None:
+    """OpenCV's functions in the calling thread only (``cv2.setNumThreads(1)``): the daemon's own policy.
+
+    OpenCV splits a call over a pool of one worker per core; at 640×480 the work is
+    too small for that to pay, and waking the workers cost the daemon ~0.07 ms of
+    CPU a frame on this 2-core VM (one worker; a Pi 4 has three), ~4 % of its CPU,
+    for no frame sooner. Like :func:`keep_freed_buffers` it sets a process-wide
+    policy: only the daemon calls it.
+    """
+    import cv2
+
+    cv2.setNumThreads(1)

@@ -139,6 +139,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
     args_list = list(sys.argv[1:] if argv is None else argv)
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")  # OpenCV's own [ WARN ] lines stay off stderr
+    if chosen_command(args_list) == "run" and "numpy" not in sys.modules:
+        # the daemon is one thread of work: OpenBLAS would start a spinning thread per core at numpy's import
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     paused_gc = chosen_command(args_list) == "run" and gc.isenabled()
     if chosen_command(args_list) == "run" and threading.current_thread() is threading.main_thread():
         _signals.install_early()  # before the heavy imports: a SIGHUP now must not end the daemon

@@ -16,7 +16,6 @@ back to parsing, silently. ``RANGEBEARING_CACHE`` names the directory
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import json
 import os
 from pathlib import Path
@@ -24,7 +23,12 @@ from typing import Any, Callable, Optional, Union
 
 from .. import _compat
 
-VERSION = 1  # of the stored form
+try:  # CPython's own BLAKE2: hashlib would load OpenSSL's libcrypto (~2.5 ms of every start)
+    from _blake2 import blake2b as _blake2b
+except ImportError:  # pragma: no cover - another Python
+    from hashlib import blake2b as _blake2b
+
+VERSION = 2  # of the stored form (2: keys are BLAKE2b)
 READ_LIMIT = 64 * 1024  # yaml_safe.MAX_BYTES (not imported: that imports PyYAML)
 
 
@@ -69,7 +73,7 @@ def _key(raw: bytes) -> str:
         stamp = f"{st.st_size}:{st.st_mtime_ns}"
     except OSError:
         stamp = "?"
-    h = hashlib.sha256(f"{VERSION}|{__version__}|{stamp}|".encode())
+    h = _blake2b(f"{VERSION}|{__version__}|{stamp}|".encode(), digest_size=20)
     h.update(raw)
     return h.hexdigest()[:40]
 
