@@ -7,6 +7,7 @@ edge, a bright background's demosaic fringe, or a neighbour's part.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import Optional
 
@@ -69,3 +70,34 @@ def seeded_band(p2d: np.ndarray, p: np.ndarray, expected: float, hb: float, hw: 
         anchored = measured(lo + ((2 * last - size + 1) if red else (2 * first + size - 1)) // 2)
         band = anchored if anchored is not None else band
     return band
+
+
+BODY_RISE = 1.5  # the white body's luma over a band's, at the least (paint: 3-10×; blur and noise eat some)
+
+
+def body_side(p: np.ndarray, band: BandEdges, red: bool, hb: float) -> BandEdges:
+    """A merged band as its luma profile ``p`` shows it against the white body (``red``: the body lies below).
+
+    The white body outshines a band in any light, so the luma rises across every band's inner edge.
+    Where it clearly falls instead (by ``BODY_RISE``: a shadow or a part in front of the body dims it
+    less), the run of strong colour the seed took was a background of the band's hue and stronger in
+    colour than it (an orange brick wall behind a crimson band, a cyan wall behind a navy
+    one), and its edge was the band's outer one: the band is the darker run between it and the body,
+    its inner edge where the luma rises to the body within ``1.5·hb + 2`` rows (half-level crossing).
+    Placed as merged all the same. Bands seen whole, or with no such rise, are returned unchanged.
+    """
+    s, n = (1 if red else -1), len(p)
+    a, b = round(band.inner - 1.5 * s), round(band.inner + 1.5 * s)  # a row on each side of the edge
+    if not band.merged or not (min(a, b) >= 0 and max(a, b) < n) or BODY_RISE * p[b] >= p[a]:
+        return band
+    end = min(n - 1, max(0, round(band.inner + s * (1.5 * hb + 2))))
+    seg = p[b : end + 1] if red else p[end : b + 1][::-1]  # from the edge into the body
+    k = int(np.argmin(seg))
+    low, white = float(seg[k]), float(seg[k:].max())
+    if not white > BODY_RISE * max(low, 1e-6):
+        return band
+    half = 0.5 * (low + white)
+    j = k + int(np.argmax(seg[k:] >= half))  # the first row at half the body's luma, past the band's darkest
+    x = j - 1 + float((half - seg[j - 1]) / (seg[j] - seg[j - 1]))  # ... interpolated from the row before
+    inner = b + s * x
+    return dataclasses.replace(band, inner=inner, centre=inner)

@@ -21,6 +21,7 @@ from typing import List, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
+from .band_seed import body_side
 from .band_seed import seeded_band as _band
 from .color import Gains
 from .column_scatter import Scatter, column_sigmas
@@ -40,14 +41,12 @@ BAND_FIT = 0.15  # a band whose edges span 15/40 of the white height within this
 class Rows:
     """A candidate's band centres (rows, full-resolution pixels) and the white body's height.
 
-    ``red_merged``/``blue_merged``: the band is placed from its inner edge and the
-    white height, because its outer edge is not its own (merged with a background
-    of its colour, or hidden). ``red_px``/``blue_px``: each band's height between
-    its two measured edges (NaN when merged). ``red_luma``/``blue_luma``: its inner
-    edge was taken from luma (the camera bleeds chroma into the white body).
-    ``red_fits``/``blue_fits``: its edges span 15/40 of the white height within
-    ``BAND_FIT`` (always for a merged band, placed from that height): :meth:`band_y`
-    then takes the edges' row alone.
+    ``red_merged``/``blue_merged``: the band is placed from its inner edge and the white height, because its
+    outer edge is not its own (merged with a background of its colour, or hidden). ``red_px``/``blue_px``:
+    each band's height between its two measured edges (NaN when merged). ``red_luma``/``blue_luma``: its
+    inner edge was taken from luma (the camera bleeds chroma into the white body). ``red_fits``/``blue_fits``:
+    its edges span 15/40 of the white height within ``BAND_FIT`` (always for a merged band, placed from
+    that height): :meth:`band_y` then takes the edges' row alone.
     """
 
     red_y_px: float
@@ -83,9 +82,9 @@ def measure_rows(
 ) -> Optional[Rows]:
     """Band centre rows of a candidate, or ``None`` when a band shows no colour step at the white body.
 
-    The profile is taken over the middle two thirds of the columns around ``x_px``
-    (the landmark's measured centre, when it is seen whole; limbs curve and
-    darken), so a full scan and a tracking window use the same columns.
+    The profile is taken over the middle two thirds of the columns around ``x_px`` (the landmark's
+    measured centre, when it is seen whole; limbs curve and darken), so a full scan and a tracking
+    window use the same columns.
     """
     return measure_rows_all(bgr, [c], gains, geometry, [x_px])[0]
 
@@ -197,6 +196,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     b_exp = (by + 0.5 * bh - oy) / f - 0.5
     red = _band(er, mean_along(er, 1), r_exp, hb, hw, True, column_sigma)
     blue = _band(eb, mean_along(eb, 1), b_exp, hb, hw, False, column_sigma)
+    if red is not None and blue is not None and lu is not None:  # a merged band's edge must be the body's
+        red, blue = body_side(mean_along(lu, 1), red, True, hb), body_side(mean_along(lu, 1), blue, False, hb)
     if red is None or blue is None or not blue.inner > red.inner:
         return None
     white = blue.inner - red.inner
@@ -284,12 +285,11 @@ def _height(band: BandEdges, red: bool) -> float:
 def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     """The blue band, marked merged when it is seen shorter than ``SHORT_BAND`` of ``expected_px``.
 
-    A nearer robot's body in front hides the lower part of a landmark behind it:
-    the blue band's outer edge is then the occluder's, and the mean of its edges
-    sits too high (L short, range long, by up to ~10 %). Both bands are 15 mm on
-    one cylinder at one depth, so the red band's height (or, when it merged,
-    15/40 of the white body's) is what the blue one should measure. A red band
-    cannot be hidden so: whatever hides its top hides the white body below it.
+    A nearer robot's body in front hides the lower part of a landmark behind it: the blue band's
+    outer edge is then the occluder's, and the mean of its edges sits too high (L short, range long,
+    by up to ~10 %). Both bands are 15 mm on one cylinder at one depth, so the red band's height (or,
+    when it merged, 15/40 of the white body's) is what the blue one should measure. A red band cannot
+    be hidden so: whatever hides its top hides the white body below it.
     """
     if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
         return blue
