@@ -59,6 +59,7 @@ FRAME_QUIRKS = {
     "no_wait": True, "builtin_timeout": True, "no_metadata": True, "metadata_none": True, "lores_unpadded": True,
     "lores_smaller": False, "map_fails": True, "xbgr": True, "release_fails": True, "close_fails": True,
     "float_timestamp": True, "no_frame_duration": True, "tuple_config": True, "flush_fails": True,
+    "flat_main": True, "flat_bytes": True,
 }
 
 
@@ -134,6 +135,26 @@ def test_a_job_handed_back_for_the_capture_is_waited_for(quirky: ModuleType, mon
     monkeypatch.setattr(quirky.Picamera2, "capture_request", lambda self, wait=None: real(self, wait=False))
     src = source()
     src.open()
+    assert src.read().image[10, 10].tolist() == true_bgr(1)  # type: ignore[union-attr]
+    src.close()
+
+
+@pytest.mark.parametrize("quirk, says", [("open_fails", "failed to open: OSError"),
+                                         ("start_fails", "cannot configure and start: bad control value")])
+def test_an_open_that_fails_in_the_library_s_own_way_is_a_camera_error_then_retried(
+        quirky: ModuleType, quirk: str, says: str) -> None:
+    quirky.QUIRKS.add(quirk)
+    waits: list = []
+    src = Picamera2Source(SourceConfig(timeout_s=0.05, retries=3), in_place=True, sleep=waits.append,
+                          stop_timeout_s=5.0)
+    if quirk == "open_fails":  # retried inside open(): the second attempt finds the camera
+        src.open()
+        assert len(waits) == 1
+    else:  # configured but not started: closed again, and the daemon's next open() works
+        with pytest.raises(CameraError, match=says):
+            src.open()
+        assert not quirky.OPEN
+        src.open()
     assert src.read().image[10, 10].tolist() == true_bgr(1)  # type: ignore[union-attr]
     src.close()
 

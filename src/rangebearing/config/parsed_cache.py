@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional, Union
 
 from .. import _compat
+from .file_bytes import is_regular, read_bounded
 
 try:  # CPython's own BLAKE2: hashlib would load OpenSSL's libcrypto (~2.5 ms of every start)
     from _blake2 import blake2b as _blake2b
@@ -45,9 +46,10 @@ def cache_dir() -> Optional[Path]:
 def parsed(path: Union[str, Path], parse: Callable[[Union[str, Path]], Any]) -> Any:
     """``parse(path)``, or the data a parse of the same bytes gave before."""
     where = cache_dir()
+    if where is None or not is_regular(path):  # a pipe or FIFO can be read once only: by the parser
+        return parse(path)
     try:
-        with open(path, "rb") as f:  # bounded: /dev/zero or a 2 GB file is the parser's to refuse, unread
-            raw: Optional[bytes] = f.read(READ_LIMIT + 1)
+        raw: Optional[bytes] = read_bounded(path, READ_LIMIT)  # a 2 GB file is the parser's to refuse, unread
     except (OSError, ValueError):  # unreadable, or a NUL in the path: the parser words it
         raw = None
     if where is None or raw is None or len(raw) > READ_LIMIT:

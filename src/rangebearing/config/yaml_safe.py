@@ -35,6 +35,7 @@ except ImportError:  # PyYAML built without libyaml
     CParser = None
 
 from ..errors import ConfigError
+from .file_bytes import read_bounded
 
 MAX_BYTES = 64 * 1024  # the documented config with every comment is ~5 KB
 MAX_DEPTH = 32  # sections are 2 levels deep, hue ranges 3
@@ -159,9 +160,8 @@ def _where(exc: yaml.MarkedYAMLError) -> str:
 def read_text(path: Union[str, Path]) -> str:
     """The file as text: at most :data:`MAX_BYTES`, UTF-8 (a leading BOM is dropped)."""
     source = str(path)
-    try:
-        with open(path, "rb") as f:  # bounded read: /dev/zero or a 2 GB file cost nothing
-            data = f.read(MAX_BYTES + 1)
+    try:  # bounded read: /dev/zero, a 2 GB file or a FIFO without a writer cost nothing
+        data = read_bounded(path, MAX_BYTES)
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the path
         raise ConfigError([f"cannot read file: {getattr(exc, 'strerror', None) or exc}"], cut(source, 200)) from None
     if len(data) > MAX_BYTES:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import time
 from typing import IO, Any, Callable, Dict, Optional, Union
 
@@ -115,6 +116,13 @@ class McapRecorder:
         self._flush_s = flush_interval_s
         self._last_flush = clock()
         self._pending = 0
+        try:
+            mode = os.stat(self.path).st_mode
+        except OSError:  # not there yet: created below (or open() words the problem)
+            mode = 0
+        if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
+            raise RecordingError(f"{self.path}: a FIFO or socket, not a file to record into "
+                                 "(opening it would wait for a reader for ever)")
         try:
             self._file: Optional[_Unbuffered] = _Unbuffered(open(self.path, "wb", buffering=0))  # noqa: SIM115
         except OSError as exc:

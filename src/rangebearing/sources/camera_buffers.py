@@ -111,17 +111,33 @@ class Layout:
     """
 
     def __init__(self, width_px: int, channels: slice, lores_size: Optional[Tuple[int, int]], swap_uv: bool,
-                 colour_space: str, camera_num: int) -> None:
+                 colour_space: str, camera_num: int, height_px: int = 0, bytes_per_px: int = 3) -> None:
         self.width_px, self.channels = width_px, channels
+        self.height_px, self.bytes_per_px = height_px, bytes_per_px
         self.lores_size, self.swap_uv, self.colour_space = lores_size, swap_uv, colour_space
         self._camera_num = camera_num
         self._warned = False
 
     def bgr(self, array: Any) -> Any:
-        """The main stream's pixels as B, G, R (a view; padding columns of an old ``make_array`` cut off)."""
+        """The main stream's pixels as B, G, R (a view; padding columns of an old ``make_array`` cut off).
+
+        A buffer handed over flat (rows of ``stride`` bytes, or one run of bytes, as
+        ``make_buffer`` gives it) is shaped as (H, W, C) first.
+        """
+        if isinstance(array, np.ndarray) and array.ndim < 3 and array.dtype == np.uint8:
+            array = self._shaped(array)
         if isinstance(array, np.ndarray) and array.ndim == 3:
             return array[:, : self.width_px, self.channels]
         return array  # validate_frame words what is wrong with it
+
+    def _shaped(self, flat: np.ndarray) -> np.ndarray:
+        h, w, c = self.height_px, self.width_px, self.bytes_per_px
+        if h <= 0 or flat.size < h * w * c or flat.size % h:
+            return flat
+        rows = flat.reshape(h, -1) if flat.flags.c_contiguous or flat.ndim == 2 else flat
+        if rows.ndim != 2 or rows.shape[1] < w * c:
+            return flat
+        return rows[:, : w * c].reshape(h, w, c)
 
     def planes(self, buffer: Optional[np.ndarray]) -> Optional[Yuv420]:
         """The Y, U, V planes of a lores buffer (views), or None: then the main image is searched instead."""
@@ -163,7 +179,8 @@ def granted(active: Dict[str, Any], camera_num: int) -> Layout:
             matrix = "smpte170m"
         else:
             size, swap = (int(lores["size"][0]), int(lores["size"][1])), lores_fmt == "YVU420"
-    return Layout(int(main["size"][0]), _TO_BGR[fmt], size, swap, matrix, camera_num)
+    return Layout(int(main["size"][0]), _TO_BGR[fmt], size, swap, matrix, camera_num, int(main["size"][1]),
+                  4 if fmt.startswith("X") else 3)
 
 
 def _matrix(colour_space: Any) -> Optional[str]:

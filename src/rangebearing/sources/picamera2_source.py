@@ -146,7 +146,7 @@ class Picamera2Source:
             self._cam = cam
             self.close()
             raise
-        except (RuntimeError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        except Exception as exc:  # deliberately broad: whatever the library raises, the camera is closed again
             self._cam = cam
             self.close()
             msg = f"camera {cfg.camera_num}: cannot configure and start: {exc}"
@@ -175,6 +175,8 @@ class Picamera2Source:
             except RuntimeError as exc:
                 error = CameraError(f"camera {n} busy or failing to open ({exc}); "
                                     "is another process using it?")
+            except Exception as exc:  # deliberately broad: a stand-in's own error for a missing or busy camera
+                error = CameraError(f"camera {n} failed to open: {exc!r}")
             if attempt < attempts:
                 _log.warning("%s; retrying in %.1f s (%d of %d)", error, delay, attempt, attempts)
                 if self._sleep(delay):  # an Event.wait that was set: stop trying

@@ -42,6 +42,9 @@ def _check_path(path: PathLike) -> Path:
         raise SourceError("no recording path given (source.path is empty)")
     if not p.exists():
         raise SourceError(f"{p}: no such file or directory")
+    if p.is_fifo() or p.is_socket():  # opening one would wait for a writer for ever
+        raise SourceError(f"{p}: a {'FIFO' if p.is_fifo() else 'socket'}, not a recording (a folder of images, "
+                          "a video or an MCAP file)")
     if p.is_dir() and not list_images(p):
         raise SourceError(f"{p}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
     if p.suffix.lower() == ".mcap" and p.is_file() and not is_mcap_file(p):

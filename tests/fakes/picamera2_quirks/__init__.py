@@ -19,6 +19,9 @@ library documents or has done:
 - ``close_fails``: ``stop()`` and ``close()`` raise RuntimeError.
 - ``float_timestamp``: ``SensorTimestamp`` is a float; ``no_frame_duration``: no ``FrameDuration``.
 - ``tuple_config``: ``camera_configuration()`` returns lists for sizes and a plain string colour space.
+- ``flat_main``: the main stream as its (H, stride) rows; ``flat_bytes``: as one run of bytes (``make_buffer``).
+- ``open_fails``: the first ``Picamera2()`` raises OSError (ENODEV); ``start_fails``: the first ``start()``
+  raises ValueError.
 
 ``SCENE(sequence) -> (H, W, 3)`` gives the frames in TRUE (R, G, B) order; ``STALLED`` makes captures wait.
 """
@@ -38,6 +41,7 @@ STALLED = threading.Event()
 OPEN: set = set()
 HELD: List[CompletedRequest] = []
 INSTANCES: List[Picamera2] = []
+FAILED: Dict[str, bool] = {}  # the one-time failures already made
 
 
 def _default_scene(sequence: int, height: int, width: int) -> np.ndarray:
@@ -70,6 +74,7 @@ def reset() -> None:
     for cam in list(INSTANCES):
         cam.close()
     QUIRKS.clear()
+    FAILED.clear()
     STALLED.clear()
     OPEN.clear()
     HELD.clear()
@@ -131,6 +136,10 @@ class CompletedRequest:
         buf = self.buffers[name]
         w, h = cfg["size"]
         fmt = cfg["format"]
+        if name == "main" and "flat_main" in QUIRKS:
+            return buf
+        if name == "main" and "flat_bytes" in QUIRKS:
+            return buf.reshape(-1)
         if fmt == "RGB888":
             return buf[:, : w * 3].reshape(h, w, 3)
         if fmt == "XBGR8888":
@@ -191,6 +200,9 @@ class Picamera2:
                  allocator: Any = None) -> None:
         if camera_num != 0:
             raise IndexError("list index out of range")
+        if "open_fails" in QUIRKS and not FAILED.get("open"):
+            FAILED["open"] = True
+            raise OSError(19, "No such device")
         if camera_num in OPEN:
             raise RuntimeError("Camera __init__ sequence did not complete.")
         OPEN.add(camera_num)
@@ -255,6 +267,9 @@ class Picamera2:
     def start(self, config: Any = None, show_preview: bool = False) -> None:
         if not self.camera_config:
             raise RuntimeError("Camera has not been configured")
+        if "start_fails" in QUIRKS and not FAILED.get("start"):
+            FAILED["start"] = True
+            raise ValueError("bad control value")
         self.started = True
 
     def _next(self, timeout: Optional[float]) -> CompletedRequest:
