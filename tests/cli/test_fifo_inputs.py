@@ -116,3 +116,9 @@ def test_recording_into_a_fifo_is_refused_at_once(tmp_path: Path, static_clip: P
     done = rangebearing("run", "--source", str(static_clip), "--fps", "0", "--record", str(target))
     assert done.returncode == 1, done.stderr
     assert "a FIFO or socket, not a file to record into" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_a_truth_fifo_is_refused_at_once(fifo: Path, static_clip: Path) -> None:
+    done = rangebearing("replay", str(static_clip), "--truth", str(fifo))
+    assert done.returncode == 1, done.stderr
+    assert "not a regular file" in done.stderr and "Traceback" not in done.stderr

@@ -128,6 +128,8 @@ def read_truth(path: PathLike) -> Dict[str, List[TruthRow]]:
     name = os.fspath(path)
     out: Dict[str, List[TruthRow]] = {}
     problems: List[str] = []
+    if os.path.exists(path) and not os.path.isfile(path) and not os.path.isdir(path):  # opening a FIFO waits
+        raise TruthError(f"{name}: not a regular file (a FIFO, socket or device), expected a truth CSV")
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
             reader = csv.DictReader(f)
