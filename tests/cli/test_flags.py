@@ -25,6 +25,7 @@ CLIP = Path(__file__).resolve().parents[2] / "samples" / "clip"
     (["run", "--source", " ", "--check"], "--source: empty"),
     (["run", "--source", "picamera2:17", "--check"], "an integer from 0 to 16"),
     (["run", "--source", "picamera2:-1", "--check"], "an integer from 0 to 16"),
+    (["run", "--source", str(CLIP), "--record", "x.mcap", "--record-max-mb", "1e-9"], "--record-max-mb: at least 1"),
 ])
 def test_flags_that_mean_nothing_are_refused(argv: List[str], says: str, capsys: Any) -> None:
     assert main(argv) == 2

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from ..view.server import ViewServer
 
 log = logging.getLogger("rangebearing.run")
+MIN_RECORD_MB = 1.0  # a 640×480 JPEG frame with its reading is ~50-100 kB
 
 
 def register(sub: Any) -> None:
@@ -61,6 +62,9 @@ def recorder_for(args: argparse.Namespace, cfg: Config) -> Optional[Any]:
         if args.record_max_mb is not None:
             raise ConfigError(["--record-max-mb needs --record FILE.mcap"], "command line")
         return None
+    if args.record_max_mb is not None and args.record_max_mb < MIN_RECORD_MB:  # a file rotated at every frame
+        raise ConfigError([f"--record-max-mb: at least {MIN_RECORD_MB:g} (MB), got {args.record_max_mb:g}: a smaller "
+                           "file holds no frame whole, and rotating at each one keeps none"], "command line")
     from ..recording.background import BackgroundRecorder
 
     max_bytes = None if args.record_max_mb is None else int(args.record_max_mb * 1e6)
