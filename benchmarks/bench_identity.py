@@ -16,7 +16,8 @@ from typing import List
 
 import numpy as np
 
-from rangebearing.core.identity import IdentityParams, empty_state, identify, update
+from rangebearing.core.identity import IdentityParams, empty_state, update
+from rangebearing.core.identity_landmarks import identify
 from rangebearing.core.types import Landmark
 
 

@@ -17,7 +17,8 @@ from typing import List, Sequence, Tuple
 import numpy as np
 import pytest
 
-from rangebearing.core.identity import empty_state, identify
+from rangebearing.core.identity import empty_state
+from rangebearing.core.identity_landmarks import identify
 from rangebearing.core.types import Landmark
 from rangebearing.evaluation.identity import IdReport, id_report
 from rangebearing.evaluation.truth import TruthRow

@@ -92,3 +92,27 @@ def test_the_small_path_and_the_numpy_path_hold_alike():
         np.testing.assert_array_equal(out_a.track_id, out_b.track_id)
         np.testing.assert_allclose(state_a.s, state_b.s, rtol=1e-9, atol=1e-12)
     assert state_a.x[0, BEARING, 0] == pytest.approx(EDGE_RAD)
+
+
+def test_a_newcomer_at_the_edge_does_not_keep_a_hidden_robots_id():
+    # robot 0 drives out at the right edge at 0.87 m and waits there; robot 1 comes in at that edge at 0.75 m
+    # and takes robot 0's held track (inside its grown gate); robot 0 comes back in: it gets its id back, and
+    # robot 1 goes on under the id it would have had (one switch, where its coming in could not be told apart)
+    state = empty_state()
+    edge = -EDGE_RAD + 0.02
+    given = {0: [], 1: []}
+    for k in range(40):
+        robots = []
+        if k < 6:
+            robots.append((0, 0.87, edge + 0.04 - 0.01 * k))
+        if k >= 9:
+            robots.append((1, 0.75 - 0.003 * (k - 9), edge + 0.01 * (k - 9)))
+        if k >= 14:
+            robots.append((0, 0.85, edge + 0.01 * (k - 14)))
+        state, out = update(state, [r for _, r, _ in robots], [b for _, _, b in robots],
+                            [0.004 * r for _, r, _ in robots], [0.0015] * len(robots), view_rad=VIEW)
+        for (robot, _, _), tid in zip(robots, out.track_id.tolist()):
+            given[robot].append(tid)
+    assert set(given[0]) == {0}
+    assert given[1][:5] == [0] * 5 and set(given[1][5:]) == {1}
+    assert state.next_id == 2  # no id made twice

@@ -19,7 +19,10 @@ Each frame (:func:`update`):
    but moves it not);
 4. unmatched tracks coast; one unmatched for more than ``max_hidden_frames``
    frames in a row is dropped; each unmatched detection starts a track with
-   the next id.
+   the next id;
+5. a track that was unseen and is taken by another robot coming into view
+   gives its id back when its own robot shows again and fits it better
+   (:mod:`.identity_reclaim`).
 
 Ids come from a counter in :class:`IdentityState` that only grows, so an id is
 never reused while the state lives. The state is a value: :func:`update`
@@ -28,17 +31,15 @@ returns a new one and never reads a clock.
 
 from __future__ import annotations
 
-import operator
-from dataclasses import fields
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from .association import associate, twins
-from .identity_small import update_small
+from .identity_reclaim import MIN_GAP, Taken, reclaimed
+from .identity_small import Small, update_small
 from .kalman import BEARING, P00, P11, RANGE, RATE, VALUE, correct, held_at_edges, measurement_variance, predict
-from .types import Landmark
 
 
 @frozen
@@ -101,6 +102,7 @@ class IdentityState:
     updates: np.ndarray  # (n,) int64
     next_id: int = 0
     t_s: Optional[float] = None  # time of the last frame, when the frames carry one
+    pending: Tuple[Taken, ...] = ()  # hidden tracks taken lately, which their own robot may still claim back
 
     @property
     def size(self) -> int:
@@ -213,19 +215,35 @@ def update(
     ``identity_small.MAX_SMALL`` tracks and readings that case runs on floats.
     """
     params = DEFAULT_PARAMS if params is None else params
-    m, n = len(range_m), state.size
+    n = state.size
     dt = _dt(state, t_s, params)
     if view_rad is not None and n:
         held = held_at_edges(state.s, dt, view_rad, params.twin_width_m)
         state = state if held is state.s else IdentityState(state.ids, held, state.hidden, state.updates,
-                                                             state.next_id, state.t_s)
+                                                             state.next_id, state.t_s, state.pending)
+    (ids, s, hidden, updates, next_id), (tid, rr, br) = _associated(
+        state, range_m, bearing_rad, range_sigma_m, bearing_sigma_rad, dt, params, visible, small)
+    pending = state.pending
+    if pending or (n and int(state.hidden.max()) >= MIN_GAP):  # a hidden track taken by the wrong robot
+        pending, (ids, s, updates, tid, rr, br) = reclaimed(
+            (state.ids, state.s, state.hidden, state.updates), state.next_id, pending, (ids, s, updates, tid, rr, br),
+            (range_m, bearing_rad, range_sigma_m, bearing_sigma_rad), visible, dt, params)
+    return (IdentityState(ids, s, hidden, updates, next_id, t_s, pending),
+            Identified(track_id=tid, range_rate_mps=rr, bearing_rate_radps=br))
+
+
+def _associated(
+    state: IdentityState, range_m: Sequence[float], bearing_rad: Sequence[float], range_sigma_m: Sequence[float],
+    bearing_sigma_rad: Sequence[float], dt: float, params: IdentityParams, visible: Optional[Sequence[float]],
+    small: bool,
+) -> Small:
+    """:func:`update`'s association, filter and births (``dt``: the time step), as arrays."""
+    m, n = len(range_m), state.size
     if small:  # a few tracks and readings, no two gates overlapping: the same arithmetic on floats
         done = update_small(state.ids, state.s, state.hidden, state.updates, state.next_id, range_m, bearing_rad,
                             range_sigma_m, bearing_sigma_rad, dt, params, visible)
         if done is not None:
-            (ids, s, hidden, updates, next_id), (tid, rr, br) = done
-            return (IdentityState(ids, s, hidden, updates, next_id, t_s),
-                    Identified(track_id=tid, range_rate_mps=rr, bearing_rate_radps=br))
+            return done
     s = predict(state.s, dt, params) if n else state.s
     hidden = state.hidden + 1
     updates, ids, next_id = state.updates, state.ids, state.next_id
@@ -264,35 +282,5 @@ def update(
         keep = hidden <= np.where(updates >= 2, params.max_hidden_frames, params.max_hidden_young_frames)
         if not keep.all():
             ids, s, hidden, updates = ids[keep], s[keep], hidden[keep], updates[keep]
-    return IdentityState(ids, s, hidden, updates, next_id, t_s), identified
-
-
-_MEASURED = operator.attrgetter("range_m", "bearing_rad", "range_sigma_m", "bearing_sigma_rad", "visible")
-_FIELDS = tuple(f.name for f in fields(Landmark))
-_ALL = operator.attrgetter(*_FIELDS)
-_TRACK, _RANGE_RATE, _BEARING_RATE = (_FIELDS.index(k) for k in ("track_id", "range_rate_mps", "bearing_rate_radps"))
-
-
-def identify(
-    state: IdentityState, landmarks: Sequence[Landmark], t_s: Optional[float], params: IdentityParams = DEFAULT_PARAMS
-) -> Tuple[IdentityState, Tuple[Landmark, ...]]:
-    """:func:`update` for a frame's landmarks: the same landmarks, in the same order, with
-    ``track_id``, ``range_rate_mps`` and ``bearing_rate_radps`` filled in.
-
-    The measured fields (``range_m``, ``bearing_rad``, the sigmas, …) are
-    copied unchanged: the filter only adds rates.
-    """
-    if landmarks:
-        cols = np.array([_MEASURED(lm) for lm in landmarks], dtype=float).T
-        state, out = update(state, cols[0], cols[1], cols[2], cols[3], t_s, params, cols[4])
-    else:
-        state, out = update(state, (), (), (), (), t_s, params)
-    labelled = []
-    for lm, tid, rr, br in zip(landmarks, out.track_id.tolist(), out.range_rate_mps.tolist(),
-                               out.bearing_rate_radps.tolist()):
-        values = list(_ALL(lm))  # a copy with three fields changed, without dataclasses.replace's cost
-        values[_TRACK] = tid
-        values[_RANGE_RATE] = None if rr != rr else rr  # NaN (no history yet) -> None
-        values[_BEARING_RATE] = None if br != br else br
-        labelled.append(Landmark(*values))
-    return state, tuple(labelled)
+    return (ids, s, hidden, updates, next_id), (identified.track_id, identified.range_rate_mps,
+                                                 identified.bearing_rate_radps)
