@@ -217,4 +217,4 @@ publish: {{robot_id: pi, unicast: ["127.0.0.1:{sub.port}"]}}
             _, stderr = proc.communicate()
     assert code == 0, stderr
     assert "Traceback" not in stderr, stderr
-    assert stderr.count("release failed") == 1, stderr  # said once, not at every frame
+    assert 1 <= stderr.count("release failed") <= 2, stderr  # once a camera opened (a reopen may say it again)
