@@ -26,10 +26,11 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
+from .arc import arc_scale
 from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
 from .denoise import Box, band_masks, median_filter, none_apart_filtered
-from .measure import CENTROID_SIGMA_X_PX, measure_columns, measure_rows, measure_rows_all
+from .measure import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
 from .search_image import SearchImage
@@ -198,6 +199,11 @@ def combine(
     else:
         x_r = x_b = cols[0]
         sx = cols[1]
+    if any(cut_sides(c, bgr.shape[1])):  # rows read over the columns that show, towards a limb (core/arc.py)
+        rx, rw = c.red_bbox_px[0], c.red_bbox_px[2]
+        k = arc_scale((rx, rx + rw), 0.5 * (x_r + x_b), 0.5 * (bgr.shape[1] - 1), fy_px, rows.white_px, geometry)
+        mid_y = 0.5 * (red_y + blue_y)
+        red_y, blue_y = mid_y - k * (mid_y - red_y), mid_y + k * (blue_y - mid_y)
     return BandCentroids(
         (x_r, red_y),
         (x_b, blue_y),
