@@ -118,3 +118,34 @@ def test_a_sharpened_luma_edge_is_its_half_level_crossing(edge):
 def test_an_unsharpened_luma_edge_stays_the_two_level_integral():
     p = _luma_profile(20.3)  # no lobes: the integral is exact, the crossing of linear interpolation is not
     assert luma_inner(p, 20.8, True, 8.0) == pytest.approx(20.3, abs=1e-4)
+
+
+def _hidden_blue(denoise_px, hide_from_px=8.0, front=0.55):
+    """:func:`_camera`'s landmark (scale 1, grey 0.3) with a nearer robot's pale body hiding the blue band
+    below ``hide_from_px`` of it, through a colour denoise of ``denoise_px``."""
+    ss, rows = 8, 120
+    y = (np.arange(rows * ss) + 0.5) / ss
+    r0 = 20.3
+    r1, b0, b1 = r0 + 15, r0 + 55, r0 + 70
+    lin = np.full((rows * ss, 3), 0.3)
+    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
+    lin[(y >= r1) & (y < b0)] = 0.85
+    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
+    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
+    img[:, :20] = img[:, 60:] = 0.3
+    img[int(b0 + hide_from_px) + 1 :, :] = front
+    img = cv2.GaussianBlur(img, (0, 0), 1.0)
+    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
+    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    cand = Candidate((20, 20, 40, 15), (20, 75, 40, 15), 40.0, False, False, False, False, 1.0)
+    return subsample_chroma(chroma_denoise(bgr, denoise_px)), cand
+
+
+def test_a_partly_hidden_blue_band_is_known_from_the_luma_when_chroma_bled_the_white_body_short():
+    # a 3 px colour denoise bleeds the bands 1.5 px each into the body: the chroma white reads 37 of 40 px,
+    # more than WHITE_MATCH off the search's, so only the luma's white says the inner edges are the body's;
+    # the blue band's lower half hidden must then be placed from its inner edge (was 3.8 px short in L)
+    img, cand = _hidden_blue(3.0)
+    rows = measure_rows(img, cand, (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert rows.blue_merged and rows.white_px == pytest.approx(40.0, abs=0.5)
+    assert rows.blue_y_px - rows.red_y_px == pytest.approx(55.0, abs=0.8)

@@ -200,13 +200,13 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         red, blue = body_side(mean_along(lu, 1), red, True, hb), body_side(mean_along(lu, 1), blue, False, hb)
     if red is None or blue is None or not blue.inner > red.inner:
         return None
-    white = blue.inner - red.inner
-    k = 0.5 * geometry.band_height_m / white_m
-    if abs(white - c.white_px / f) <= WHITE_MATCH * c.white_px / f:  # the inner edges are the body's own
-        blue = _hidden(blue, _height(red, True) or 2 * k * white)
+    white, k = blue.inner - red.inner, 0.5 * geometry.band_height_m / white_m
+    cw, tol = c.white_px / f, WHITE_MATCH * c.white_px / f  # inner edges (chroma or luma) this close: the body's
+    blue = _hidden(blue, _height(red, True) or 2 * k * white) if abs(white - cw) <= tol else blue
     luma = (False, False)
     if lu is not None and not (red.merged and blue.merged):
         l_red, l_blue, l_white = _luma_edges(mean_along(lu, 1), red, blue, 2 * k * white)
+        l_blue = _hidden(l_blue, _height(l_red, True) or 2 * k * l_white) if abs(l_white - cw) <= tol else l_blue
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
         if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
