@@ -106,3 +106,10 @@ def test_bad_alt_settings_are_named():
         Scene(imaging=Imaging(tone="log"))
     with pytest.raises(SceneError, match="h264_quality"):
         Scene(imaging=Imaging(h264_quality=101))
+
+
+def test_alt_preset_draws_pincushion_and_mjpeg_too():
+    scenes = [random_scene(np.random.default_rng(100 + i), ALT_PRESET, TINY) for i in range(40)]
+    k1 = [s.imaging.barrel_k1 for s in scenes]
+    assert min(k1) < 0 < max(k1) <= 0.008 and min(k1) >= -0.012  # barrel and pincushion residuals
+    assert any(40 <= s.imaging.jpeg_quality <= 75 for s in scenes)  # an MJPEG stream's coarse JPEG

@@ -10,10 +10,11 @@ exact (see docs/synth.md, "Another camera"):
 - **tone curve**: the sRGB curve or a filmic S-curve instead of a plain gamma;
 - **exposure** off by 1–2 stops (an AE metering another way, a bright or dark scene);
 - **vignetting** up to 50 % in the corners, **lateral colour** up to ±0.4 % (a
-  red/blue fringe of ~1 px at the frame's sides), a small **barrel distortion**
-  the detector's camera does not know of (a calibration's residual);
+  red/blue fringe of ~1 px at the frame's sides), a small **barrel or pincushion
+  distortion** the detector's camera does not know of (a calibration's residual);
 - **motion blur** of the whole frame: the observing robot turning (1–8 px);
-- **video coding**: chroma in 2×2 blocks and coarse 8×8 transform coding;
+- **video coding**: chroma in 2×2 blocks and coarse 8×8 transform coding; or
+  an **MJPEG stream** at JPEG quality 40–75;
 - **glossy paint** with tight specular streaks along the cylinder;
 - **paint off ours**: red towards orange or magenta, blue towards cyan or
   violet, less saturated or dirty paint, an off-white (cream, grey) body;
@@ -35,8 +36,8 @@ from .scene import BLUE_PAINT, RED_PAINT, RGB, WHITE_PAINT, Scene
 
 ALT_PRESET = "photoreal-alt"
 ALT_HELP = {ALT_PRESET: "photoreal scenes through another camera: sRGB/filmic tone, +-1-2 stops, "
-                        "vignetting, lateral colour, barrel, pan blur, video coding, glossy streaks, "
-                        "paint hues off ours, colour bleed from red/blue walls"}
+                        "vignetting, lateral colour, barrel/pincushion, pan blur, video coding or MJPEG, "
+                        "glossy streaks, paint hues off ours, colour bleed from red/blue walls"}
 DISPLAY_GAMMA = 2.2  # paint hues are turned in display space, where a hue threshold sees them
 WALLS: Tuple[RGB, ...] = ((0.55, 0.07, 0.05), (0.62, 0.18, 0.08), (0.06, 0.10, 0.50), (0.10, 0.22, 0.55))
 
@@ -58,9 +59,13 @@ def alt_camera(rng: np.random.Generator, scene: Scene) -> Scene:
     pan = d.uniform(rng, 1.0, 8.0) if rng.random() < 0.3 else 0.0
     barrel = d.uniform(rng, -0.012, 0.0) if rng.random() < 0.5 else 0.0
     video = int(rng.integers(35, 71)) if rng.random() < 0.3 else 0
+    if barrel == 0.0 and rng.random() < 0.4:  # a pincushion residual (a longer lens, a calibration the other way)
+        barrel = d.uniform(rng, 0.0, 0.008)
+    # a camera streaming MJPEG: coarser JPEG than a still's (the video coding wins where both are drawn)
+    jpeg = int(rng.integers(40, 76)) if rng.random() < 0.25 else im.jpeg_quality
     imaging = dataclasses.replace(
         im, tone=tone, gamma=gamma, ae_error=ae_error, pan_blur_px=pan, barrel_k1=barrel,
-        h264_quality=video, vignetting=d.uniform(rng, 0.15, 0.5),
+        h264_quality=video, jpeg_quality=jpeg, vignetting=d.uniform(rng, 0.15, 0.5),
         lateral_colour=d.uniform(rng, -1.0, 1.0) * 0.004)
     light = scene.lighting
     if rng.random() < 0.5:  # glossy plastic with tight highlights: streaks along the cylinder
