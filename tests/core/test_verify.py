@@ -125,9 +125,20 @@ def striped_frame():
 
 def test_red_and_white_running_on_beyond_both_sides_are_stripes_not_a_landmark():
     assert "stripes" in rejection(striped_frame(), found(), GEOMETRY)
+    assert rejection(frame(), found(), GEOMETRY) is None
+
+
+def test_stripes_running_on_beside_one_side_are_stripes_whatever_ends_them_on_the_other():
+    # beyond the right side the wall is grey (or a mast stands there): the left still shows red over white
+    # at the band's and the body's own rows, which no background beside a real landmark lines up with
     one_side = striped_frame()
-    one_side[:, X1 + 2 :] = frame()[:, X1 + 2 :]  # beyond the right side the wall is grey: an object's side
-    assert rejection(one_side, found(), GEOMETRY) is None
+    one_side[:, X1 + 2 :] = frame()[:, X1 + 2 :]
+    assert "stripes" in rejection(one_side, found(), GEOMETRY)
+    assert "stripes" in rejection(masted(striped_frame(), (X1 + 2, X1 + 20)), found(), GEOMETRY)
+    # a real landmark before a grey wall with a red poster's edge beside it at its red rows only: no stripes
+    poster = frame()
+    poster[RED_ROWS[0] : RED_ROWS[1], : X0 - 2] = poster[RED_ROWS[0], X0]
+    assert rejection(poster, found(), GEOMETRY) is None
 
 
 def test_a_touching_neighbour_beside_it_is_no_stripe():
@@ -145,10 +156,10 @@ def test_a_neighbour_on_one_side_excuses_only_its_own_columns():
     # a narrow neighbour covers under a third of the right strip: what is left of it is judged
     sliver = dataclasses.replace(c, red_bbox_px=(X1 + 6, RED_ROWS[0], 4, 15),
                                  blue_bbox_px=(X1 + 6, BLUE_ROWS[0], 4, 15))
-    beside_grey = striped_frame()
-    beside_grey[:, X1 + 2 :] = frame()[:, X1 + 2 :]  # beyond the right side the wall is grey
-    assert rejection(beside_grey, c, GEOMETRY, others=[c, sliver]) is None
-    assert "stripes" in rejection(striped_frame(), c, GEOMETRY, others=[c, sliver])
+    right_only = striped_frame()
+    right_only[:, : X0 - 2] = frame()[:, : X0 - 2]  # left of it the wall is grey: only the right side can tell
+    assert "stripes" in rejection(right_only, c, GEOMETRY, others=[c, sliver])
+    assert rejection(frame(), c, GEOMETRY, others=[c, sliver]) is None
 
 
 def wide(img, width=200, at=80):
@@ -201,6 +212,7 @@ def test_stripes_running_on_beyond_a_mast_beside_it_are_still_stripes():
 def test_a_neighbour_beyond_a_mast_is_no_stripe():
     c = cut(shifted(found(), 80))
     stripes = masted(wide(striped_frame()), (144, 160))
+    left = shifted(c, -44)  # a landmark right beside its left side (columns 56-96): only the right is judged
     neighbour = shifted(c, 62)  # another candidate at the stripes' rows beyond the mast (columns 162-202)
-    assert "stripes" in rejection(stripes, c, GEOMETRY)  # the stripes beyond the mast
-    assert rejection(stripes, c, GEOMETRY, others=[c, neighbour]) is None  # a neighbour's own bands and body
+    assert "stripes" in rejection(stripes, c, GEOMETRY, others=[c, left])  # the stripes beyond the mast
+    assert rejection(stripes, c, GEOMETRY, others=[c, left, neighbour]) is None  # a neighbour's own bands and body

@@ -42,13 +42,17 @@ the checks here ask for:
   something in front of the mat ends the blue for a while, the structure finds
   a "landmark" there. A landmark is an object: beside it, at the rows of its red
   band and of its white body, lies something else (a background, a wall), not
-  both of its own colours again. A candidate whose band and body colours both
-  run on, unchanged, beyond its sides is no landmark. Columns where another
+  both of its own colours again, lined up with its red band's and its body's
+  own rows. A candidate whose band and body colours both run on, unchanged,
+  right beside one of its sides is no landmark, whatever ends them on the
+  other (a mast, a robot, a neighbour standing there; the stripes' end); nor is
+  one whose colours run on beyond every side judged. Columns where another
   candidate stands are not looked at (touching neighbours show their own bands
   and bodies), but the rest of that side is: a real landmark right beside a
   skirting board excuses none of the board. Nor does a robot's mast and camera
   board in front of the stripes right beside the false one (what often ends
-  it): the stripes run on when they show again a little farther out.
+  it): the stripes run on when they show again a little farther out (on every
+  side judged: farther out another object's own colours may show).
 
 Levels are taken in linear light over the middle three fifths of the
 candidate's visible columns (limbs darken and mix with the background); of
@@ -62,7 +66,6 @@ from __future__ import annotations
 import math
 from typing import List, Optional, Sequence, Tuple
 
-import cv2
 import numpy as np
 
 from .detect import BandCentroids
@@ -97,18 +100,18 @@ def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]
 
 
 def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[List[float]]:
-    """Linear RGB (B, G, R order) of a region's mean 8-bit colour, ``None`` when the region is empty."""
+    """Linear RGB (B, G, R order) of a region's median 8-bit colour, ``None`` when the region is empty."""
     h, w = bgr.shape[:2]
     r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
     c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
     if r1 <= r0 or c1 <= c0:
         return None
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
-    sub = bgr[r0:r1:rs, c0:c1:cs]
-    n = sub.shape[0] * sub.shape[1]
-    # the channel sums are exact integers (as floats: below 2**53): the mean's values (np.mean's float sum) in
-    # three Python floats; OpenCV sums a strided region several times faster than numpy's uint8 → int64 reduction
-    return [(total / n / 255.0) ** 2.2 for total in cv2.sumElems(sub)[:3]]
+    # the median: a thin line of another colour in the region (a brick wall's mortar, a mast's edge) moves it not
+    # (np.median's values; a sort of the few sampled pixels costs a third of its call)
+    sub = np.sort(bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), axis=0)
+    n = sub.shape[0]
+    return [((lo + hi) / 510.0) ** 2.2 for lo, hi in zip(sub[(n - 1) // 2].tolist(), sub[n // 2].tolist())]
 
 
 def _same(a: Optional[List[float]], b: Optional[List[float]]) -> bool:
@@ -127,9 +130,11 @@ def _free(side: Tuple[float, float], boxes: Sequence[Tuple[float, float]]) -> Op
     return best if best[1] - best[0] >= max(1.0, (side[1] - side[0]) / 3) else None
 
 
-def _sides(c: BandCentroids, boxes: Sequence[Tuple[float, float]], frame_w: int) -> List[List[Tuple[float, float]]]:
-    """Per side of ``c`` judged (its nearest window free), the free column spans of its windows, nearest first
-    (farther windows only on a side where its run was cut: one that ends at its limb shows what lies beside it)."""
+def _sides(c: BandCentroids, boxes: Sequence[Tuple[float, float]],
+           frame_w: int) -> List[Tuple[bool, List[Tuple[float, float]]]]:
+    """Per side of ``c`` judged (its nearest window free), whether its run was cut there and the free column spans
+    of its windows, nearest first (farther windows only on a cut side: one that ends at its limb shows what lies
+    beside it)."""
     x, _, w, _ = c.bbox_px
     cand = c.candidate
     out = []
@@ -146,7 +151,7 @@ def _sides(c: BandCentroids, boxes: Sequence[Tuple[float, float]], frame_w: int)
             elif not k:  # a neighbour right beside it: the side is not judged (it shows the neighbour)
                 break
         if found:
-            out.append(found)
+            out.append((cut, found))
     return out
 
 
@@ -163,8 +168,11 @@ def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, flo
     ``SIDE_WINDOWS - 1`` as wide stepping outwards (0.45 of the width each, on
     what no neighbour covers): a thin thing in front of the stripes right beside
     it (a robot's mast and camera board, which often end the false "landmark")
-    does not hide that they go on. Stripes run on beyond every side judged, and
-    at least one is.
+    does not hide that they go on. Stripes: the layers show unchanged right
+    beside one side judged (no background beside a real landmark lines up red
+    and white with its band's and its body's rows), or beyond every side judged,
+    and at least one is. Colours are medians (a brick wall's mortar or a mast's
+    edge in a window moves them not).
     """
     boxes = [(b[0] - 1.0, b[0] + b[2] + 1.0) for b in (o.bbox_px for o in others if o is not c)]  # a property: once
     sides = _sides(c, boxes, bgr.shape[1])
@@ -179,7 +187,12 @@ def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, flo
         return _same(own[rows], _colour(bgr, rows, span))
 
     # body first: beside most real landmarks it is the background, and one differing layer ends the test
-    return all(any(all(same(rows, span) for rows in reversed(layers)) for span in windows) for windows in sides)
+    def runs_on(span: Tuple[float, float]) -> bool:
+        return all(same(rows, span) for rows in reversed(layers))
+
+    if any(not cut and runs_on(windows[0]) for cut, windows in sides):  # beside a limb that is none
+        return True
+    return all(any(map(runs_on, windows)) for _, windows in sides)
 
 
 def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
@@ -242,7 +255,7 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     if red_r > BAND_OVER_WHITE * white_r or blue_b > BAND_OVER_WHITE * white_b:
         return "the white body is darker than a band in the band's own channel"
     if striped(bgr, c, ((ry - 0.25 * band, ry + 0.25 * band), body), others):
-        return "its red band and white body run on beyond both sides: stripes, not an object"
+        return "its red band and white body run on beside it: stripes, not an object"
     return None
 
 
