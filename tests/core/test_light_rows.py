@@ -25,6 +25,16 @@ def test_a_dark_band_still_steps_from_the_white_body(level):
     assert edges.centre == pytest.approx(32.0, abs=0.05)
 
 
+def test_a_band_two_stops_under_steps_from_the_white_body():
+    # a frame 2 stops under (photoreal-alt): the red band reads V ~25, 0.0045 above the body in linear light,
+    # nine times the column-mean profile's noise there (0.0005 a row): the gamma's slope, not the noise, made it small
+    rng = np.random.default_rng(18034)
+    p2d = profile(0.0045, 0.0, -0.002) + rng.normal(0.0, 0.0005, (130, 1)).astype(np.float32)
+    edges = band_rows(p2d, 26, 38, True, 58, 12)
+    assert edges is not None
+    assert edges.inner == pytest.approx(44.5, abs=0.5)
+
+
 def test_no_colour_step_is_no_band_however_dark():
     p2d = profile(0.004, 0.003, -0.01)  # a faintly red-grey surface, no band
     assert band_rows(p2d, 26, 38, True, 58, 12) is None

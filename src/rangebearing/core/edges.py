@@ -27,7 +27,7 @@ from .color import Gains
 
 GAMMA = 2.2
 BG_ROWS = 4  # rows averaged for a background level
-STEP_MIN, STEP_SHARE, STEP_NOISE = 0.02, 0.3, 0.005  # see step_floor
+STEP_MIN, STEP_SHARE, STEP_NOISE = 0.02, 0.3, 0.0015  # see step_floor
 RHO_MAX = 0.8  # the columns' lag-1 error correlation counted at most (_column_sigma; from ~10-40 columns)
 MERGE_CONTRAST = 0.5  # an outer edge whose level step is below this share of the band's level is merged
 
@@ -143,7 +143,11 @@ def band_rows(
 
 def step_floor(level: float) -> float:
     """The smallest colour step at the white body that makes a band: 0.02 in linear light, less for
-    a dark band (dim light, a backlit landmark), down to 30 % of its own level but not into the noise."""
+    a dark band (dim light, a backlit landmark), down to 30 % of its own level but not into the noise.
+
+    The noise floor is in linear light, where the tone curve's slope shrinks a dark pixel's noise with
+    its level: in a frame 2 stops under (band at V ~25) a band steps ~0.005 from the body and the
+    column-mean profile's noise is ~0.0005 a row, so the floor (``STEP_NOISE``) is three times that."""
     return min(STEP_MIN, max(STEP_NOISE, STEP_SHARE * level))
 
 
