@@ -67,12 +67,27 @@ def test_range_sigma_follows_the_spacing_error_through_the_model():
     assert u.range_sigma_m(1.0, 0.014, 30.0, 1.0, 1.0) > base  # noisier edges
     assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, chroma_blur_px=1.0) > base  # colour blurrier than luma
     assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, cut=(False, True)) > base  # placed from one limb
+    assert u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, clipped=1.0) > base  # over-exposed white body
     # dominated by the spacing term, sigma/range grows like (d - c)/L: double range, half L, four times
     far = u.range_sigma_m(2.0, 0.0, 15.0, 2.0, 1.0, 1.0)
     near = u.range_sigma_m(1.0, 0.0, 30.0, 2.0, 1.0, 1.0)
     assert far / near == pytest.approx(4.0, rel=0.02)
     # never below the model's own error after calibration
     assert u.range_sigma_m(0.5, 0.014, 100.0, 0.0, 1.0) >= u.MODEL_FLOOR * 0.5
+
+
+def test_white_clipped_is_the_share_of_the_body_between_the_bands_at_full_scale():
+    img = np.full((100, 60, 3), 120, np.uint8)
+    img[20:30, 20:40] = (40, 40, 200)  # red band rows 20-29, centre 24.5
+    img[30:70, 20:40] = 255  # white body, clipped
+    img[70:80, 20:40] = (200, 60, 40)  # blue band, centre 74.5
+    red, blue = (29.5, 24.5), (29.5, 74.5)
+    assert u.white_clipped(img, red, blue, 20.0) == 1.0
+    img[30:50, 20:40] = (230, 235, 240)  # the upper half exposed, not clipped
+    assert u.white_clipped(img, red, blue, 20.0) == pytest.approx(0.5, abs=0.05)
+    img[30:70, 20:40] = (250, 252, 200)  # a channel below the clip level: not clipped
+    assert u.white_clipped(img, red, blue, 20.0) == 0.0
+    assert u.white_clipped(img[..., 0], red, blue, 20.0) == 0.0  # a grey frame: no colour to judge
 
 
 def test_bearing_sigma_grows_with_band_disagreement_hiding_and_splitting():

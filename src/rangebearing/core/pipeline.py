@@ -36,7 +36,7 @@ from .search_image import SearchImage
 from .structure import Found
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
-from .uncertainty import chroma_blur_all, chroma_blur_px, reading_sigma
+from .uncertainty import chroma_blur_all, chroma_blur_px, reading_sigma, white_clipped
 from .verify import verified
 from .yuv import Yuv420, half_luma, yuv_grey_world_gains, yuv_search
 
@@ -272,7 +272,8 @@ class Pipeline:
         if blur_px is None:
             blur_px = chroma_blur_px(bgr, c.red_xy_px, c.blue_xy_px, width_px, self._gains)
         s_r, s_b = reading_sigma(rng, bearing, l_px, c.sigma_l_px, c.sigma_x_px, width_px, c.visible, c_m, cam.fx_px,
-                                 c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut, blur_px)
+                                 c.spread_l_px, 0.5 * abs(c.red_xy_px[0] - c.blue_xy_px[0]), cut, blur_px,
+                                 white_clipped(bgr, c.red_xy_px, c.blue_xy_px, width_px))
         return (rng, bearing, d_v, d_h, l_px, c.red_xy_px, c.blue_xy_px, width_px, c.bbox_px,
                 in_envelope(rng, bearing, model), s_r, s_b, c.visible)
 

@@ -25,6 +25,10 @@ combines what this very frame shows about its own measurement:
 * a partly hidden landmark's edges are seen over a part of the curve:
   ``HIDDEN_SHARE_L`` of L per unit of hidden share; a landmark cut on one side
   or both (a neighbour, the frame's edge): ``CUT_SHARE_L``/``SPLIT_SHARE_L`` of L;
+* an over-exposed white body (clipped at full scale) swallows the mixed pixels of the
+  bands' inner edges, by up to a pixel and the blur, so both bands read short towards the
+  body and L long; nothing else in the frame shows it (clipping even hides the noise):
+  ``CLIPPED_PX`` per band centre times the clipped share of the body (:func:`white_clipped`);
 * a floor: ``EDGE_FLOOR_PX`` per band, and the model's own error after
   calibration (``MODEL_FLOOR``, relative).
 
@@ -62,6 +66,8 @@ FIT_SPREAD = 0.21  # share of |moment − edge| a row from its edges alone errs 
 MOMENT_PX = 0.22  # the chroma moment's own error (px): the part of |moment − edge| a row from its edges lacks
 EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the outline's curve
 CHROMA_SHARE = 0.14  # per band centre, share of the colour's own blur (chroma_blur_px)
+CLIPPED_PX = 0.2  # per band centre, a wholly clipped white body's pull on the inner edges
+CLIP_LEVEL = 248  # an 8-bit channel this bright is clipped (JPEG rings a clipped area a few levels down)
 MERGED_PX = 1.42  # a band placed from its inner edge and the white height (heights on a curved surface)
 HIDDEN_SHARE_L = 0.138  # share of L per unit of hidden share (the edges' curve over the visible part)
 SPLIT_SHARE_L = 0.00596  # share of L: a landmark cut on both sides (split between neighbours)
@@ -207,6 +213,20 @@ def row_spread_px(
     return math.sqrt(terms[0] + terms[1])
 
 
+def white_clipped(bgr: np.ndarray, red_xy_px: Tuple[float, float], blue_xy_px: Tuple[float, float],
+                  width_px: float) -> float:
+    """Share (0-1) of the white body's pixels, between the bands and over the middle two thirds of
+    its columns, clipped in every channel (at least ``CLIP_LEVEL``)."""
+    h, w = bgr.shape[:2]
+    half = 0.5 * BAND_SHARE * (blue_xy_px[1] - red_xy_px[1])
+    y0, y1 = max(0, math.ceil(red_xy_px[1] + half)), min(h, math.floor(blue_xy_px[1] - half) + 1)
+    x = 0.5 * (red_xy_px[0] + blue_xy_px[0])
+    x0, x1 = int(max(0, x - width_px / 3)), int(min(w, x + width_px / 3 + 1))
+    if y1 <= y0 or x1 <= x0 or bgr.ndim != 3:
+        return 0.0
+    return float(np.mean(bgr[y0:y1, x0:x1].min(axis=2) >= CLIP_LEVEL))
+
+
 def silhouette_share(visible: float, search_white_px: float, white_px: float, fy_px: float,
                      geometry: LandmarkGeometry) -> float:
     """``visible`` (the structure search's run width over the silhouette it expected) against the
@@ -230,19 +250,21 @@ def silhouette_share(visible: float, search_white_px: float, white_px: float, fy
 
 def range_sigma_m(
     range_m: float, c_m: float, l_px: float, sigma_l_px: float, visible: float, spread_l_px: float = 0.0,
-    chroma_blur_px: float = 0.0, cut: Tuple[bool, bool] = (False, False),
+    chroma_blur_px: float = 0.0, cut: Tuple[bool, bool] = (False, False), clipped: float = 0.0,
 ) -> float:
     """One-sigma range error (m) of a reading at ``range_m`` from band spacing ``l_px``.
 
     ``sigma_l_px`` is the column scatter's standard error, ``spread_l_px`` the
     estimators' disagreement (:func:`row_spread_px`), ``chroma_blur_px`` the colour's
     own blur (:func:`chroma_blur_px`), ``cut`` whether the landmark ends at a
-    neighbour or the frame's edge on its left, right side.
+    neighbour or the frame's edge on its left, right side, ``clipped`` the white body's clipped
+    share (:func:`white_clipped`).
     """
     hidden = HIDDEN_SHARE_L * (1.0 - min(1.0, visible)) * l_px
     split = (SPLIT_SHARE_L if all(cut) else CUT_SHARE_L if any(cut) else 0.0) * l_px
     s_l = math.sqrt((NOISE_SHARE * sigma_l_px) ** 2 + (SPREAD_SHARE * spread_l_px) ** 2
-                    + 2 * (EDGE_FLOOR_PX**2 + (CHROMA_SHARE * chroma_blur_px) ** 2) + hidden**2 + split**2)
+                    + 2 * (EDGE_FLOOR_PX**2 + (CHROMA_SHARE * chroma_blur_px) ** 2 + (CLIPPED_PX * clipped) ** 2)
+                    + hidden**2 + split**2)
     spacing = max(range_m - c_m, 0.0) * s_l / max(l_px, 1e-6)
     return math.hypot(spacing, MODEL_FLOOR * range_m)
 
@@ -266,10 +288,10 @@ def bearing_sigma_rad(
 def reading_sigma(
     range_m: float, bearing_rad: float, l_px: float, sigma_l_px: float, sigma_x_px: float, width_px: float,
     visible: float, c_m: float, fx_px: float, spread_l_px: float = 0.0, spread_x_px: float = 0.0,
-    cut: Tuple[bool, bool] = (False, False), chroma_blur_px: float = 0.0,
+    cut: Tuple[bool, bool] = (False, False), chroma_blur_px: float = 0.0, clipped: float = 0.0,
 ) -> Tuple[float, float]:
     """``(range_sigma_m, bearing_sigma_rad)`` of one reading."""
     return (
-        range_sigma_m(range_m, c_m, l_px, sigma_l_px, visible, spread_l_px, chroma_blur_px, cut),
+        range_sigma_m(range_m, c_m, l_px, sigma_l_px, visible, spread_l_px, chroma_blur_px, cut, clipped),
         bearing_sigma_rad(bearing_rad, sigma_x_px, width_px, fx_px, visible, spread_x_px, cut),
     )
