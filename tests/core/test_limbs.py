@@ -149,3 +149,21 @@ def test_beside_a_nearer_landmark_a_far_side_whose_band_runs_on_past_the_run_giv
     c = Candidate((50, 20, 24, 15), (50, 76, 24, 15), 40.0, False, False, True, True, 0.7, occluded="left")
     got = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
     assert got is None or abs(got[0] - _centre(74.3, True)) < 0.3
+
+
+def test_a_mast_in_front_of_one_band_does_not_end_the_other_bands_limb():
+    # cut on the left (the frame's edge, a neighbour); its robot's dark mast stands in front of the blue band at
+    # columns 60-64, inside the run the search saw (to 74): the blue band's "limb" there is the mast's edge; the
+    # red band's limb at 74.3 ends the run and places it (the inner limb placed it 14 px left, 3.7 deg at 0.25 m)
+    img = _frame(40.3, 74.3)
+    img[75:90, 60:64] = 40
+    c = Candidate((41, 20, 33, 15), (41, 76, 33, 15), 40.0, False, False, True, False, 0.9)
+    x, _ = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(74.3, True), abs=0.05)
+    # a same-coloured background beside the blue band carries it past the run's end: the inner limb still wins
+    lin = (img.astype(np.float64) / 255.0) ** 2.2
+    lin[75:90, 60:64] = (0.65, 0.12, 0.06)  # BGR: the band's blue again, no mast
+    lin[75:90, 74:110] = (0.65, 0.12, 0.06)
+    img = np.round(255.0 * lin ** (1 / 2.2)).astype(np.uint8)
+    x, _ = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(74.3, True), abs=0.05)

@@ -165,6 +165,13 @@ def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGe
         return None
     if len(edges) == 2 and abs(edges[0] - edges[1]) <= LIMB_AGREE_PX:
         return 0.5 * (edges[0] + edges[1])
+    # apart: a same-coloured background widened one band (the inner limb is the cylinder's), or a thing in front of
+    # one (its robot's mast across the blue band) ended it short of the limb; only the limb ending the run the
+    # structure search saw on this side (red over white over blue) can be the cylinder's
+    run_end = rx + rw if right else rx
+    at_end = [e for e in edges if abs(e - run_end) <= RUN_END_PX + RUN_END_SHARE * 2 * half]
+    if len(edges) == 2 and len(at_end) == 1:
+        return at_end[0]
     return min(edges) if right else max(edges)
 
 
