@@ -114,10 +114,10 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
     "camera": (
         CameraIntrinsics,
         {
-            "width_px": ck.positive(True),
-            "height_px": ck.positive(True),
-            "fx_px": ck.positive(),
-            "fy_px": ck.positive(),
+            "width_px": ck.number(1, 10000, integer=True),  # as cx_px/cy_px: an image up to 10,000 px a side
+            "height_px": ck.number(1, 10000, integer=True),
+            "fx_px": ck.number(1, 1e6),  # a focal of 1e-300 px overflowed every ray, 1e308 px every pixel
+            "fy_px": ck.number(1, 1e6),
             "cx_px": ck.number(0, 10000),
             "cy_px": ck.number(0, 10000),
             "distortion": ck.distortion,
@@ -126,9 +126,11 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
     "landmark": (
         LandmarkGeometry,
         {
-            "height_m": ck.positive(),
-            "diameter_m": ck.positive(),
-            "band_height_m": ck.positive(),
+            # a landmark from 1 mm to 10 m: a 1e-9 m one made the search look for nanometre bands (minutes a
+            # frame), a 1e308 m one overflowed the projected size
+            "height_m": ck.number(0.001, 10),
+            "diameter_m": ck.number(0.001, 10),
+            "band_height_m": ck.number(0.001, 10),
         },
     ),
     "detection": (
