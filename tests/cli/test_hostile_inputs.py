@@ -164,10 +164,16 @@ def hostile_recording(kind: str, clip: Path, where: Path) -> Tuple[Path, int, in
         cv2.imwrite(str(d / "003.png"), cv2.resize(good[2], (320, 240), interpolation=cv2.INTER_AREA))
         cv2.imwrite(str(d / "004.png"), good[2][:, :600])
         return d, 3, 1
+    if kind == "broken links":  # a dangling link and a loop named like frames: bad frames, counted, not missing
+        (d / "003.png").symlink_to(where / "nowhere.png")
+        (d / "004.png").symlink_to(d / "005.png")
+        (d / "005.png").symlink_to(d / "004.png")
+        return d, 2, 3
     raise AssertionError(kind)
 
 
-RECORDINGS = ["non-image files", "truncated png and jpeg", "16-bit grey and alpha", "huge images", "mixed sizes"]
+RECORDINGS = ["non-image files", "truncated png and jpeg", "16-bit grey and alpha", "huge images", "mixed sizes",
+              "broken links"]
 
 
 @pytest.mark.parametrize("kind", RECORDINGS)

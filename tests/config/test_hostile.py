@@ -206,3 +206,10 @@ def test_the_extremes_allowed_run_the_pipeline(landmark: tuple, fx_px: float) ->
     pipe = Pipeline(cfg.pipeline, track=True)
     for _ in range(2):
         pipe.process(frame)  # raises nothing, in well under a second
+
+
+@pytest.mark.parametrize("text, hint", [("landmark: {diameter_m: 35e-3}\n", True), ("camera: {fx_px: '634'}\n", True),
+                                        ("camera: {fx_px: lots}\n", False), ("camera: {fx_px: 1e999}\n", False)])
+def test_a_number_yaml_reads_as_text_says_how_to_write_it(tmp_path: Path, text: str, hint: bool) -> None:
+    """YAML 1.1 reads 35e-3 (no dot) as a string: 'must be a number, got '35e-3'' alone baffles."""
+    assert ("with a dot before any exponent" in str(_load(tmp_path, text))) is hint

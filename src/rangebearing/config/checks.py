@@ -71,10 +71,19 @@ def number(lo: float = -math.inf, hi: float = math.inf, integer: bool = False, a
         ok = ok and -1.8e308 < v < 1.8e308 and not (isinstance(v, float) and math.isnan(v))
         ok = ok and (not integer or float(v).is_integer()) and lo <= v <= hi and v > above
         if not ok:
-            raise ValueError(f"must be {allowed}, got {show(v)}")
+            raise ValueError(f"must be {allowed}, got {show(v)}{_text_number_hint(v)}")
         return int(v) if integer else float(v)
 
     return check
+
+
+def _text_number_hint(v: Any) -> str:
+    """Why a number the user wrote is text: YAML 1.1 reads ``35e-3`` (no dot) or ``'634'`` as a string."""
+    try:
+        ok = isinstance(v, str) and len(v) <= 40 and math.isfinite(float(v.strip()))
+    except ValueError:
+        ok = False
+    return " (YAML reads it as text: write it unquoted, with a dot before any exponent, e.g. 35.0e-3)" if ok else ""
 
 
 def positive(integer: bool = False) -> Check:

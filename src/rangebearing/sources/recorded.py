@@ -24,9 +24,10 @@ _CACHE_BYTES = 64 * 1024 * 1024  # decoded frames kept in memory for looping whe
 
 
 def list_images(directory: Path) -> List[Path]:
-    """Image files in ``directory`` sorted by name; other files (truth.csv…) are ignored."""
+    """Image files in ``directory`` sorted by name (a broken link too: a bad frame, counted); others ignored."""
     return sorted(
-        (p for p in directory.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES and p.is_file()),
+        (p for p in directory.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES
+         and (p.is_file() or (p.is_symlink() and not p.exists()))),
         key=lambda p: p.name,
     )
 
