@@ -138,3 +138,18 @@ def test_run_starts_with_the_destinations_that_resolve(tmp_path, monkeypatch):
 def test_bad_command_line_sources_are_config_errors(spec, message, capsys):
     assert main(["run", "--source", spec, "--check"]) == 2
     assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("where", ["build_parser", "_run"])
+def test_ctrl_c_while_the_command_still_loads_is_exit_130_without_a_traceback(
+    where: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """SIGINT 0.1-0.4 s into a command landed in its imports (parse, module load), outside the error funnel."""
+    from rangebearing.cli import main as main_mod
+
+    def interrupted(*_args: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(main_mod, where, interrupted)
+    assert main_mod.main(["replay", "nowhere"]) == main_mod.EXIT_INTERRUPTED
+    assert "Traceback" not in capsys.readouterr().err

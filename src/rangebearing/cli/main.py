@@ -149,6 +149,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         gc.disable()  # they are made; the daemon freezes them after its first frame and collects again
     try:
         return _run(args_list)
+    except KeyboardInterrupt:  # Ctrl-C while the command's modules still load (before it runs): no traceback
+        return EXIT_INTERRUPTED
     finally:
         if paused_gc:
             gc.enable()
