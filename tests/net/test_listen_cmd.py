@@ -11,7 +11,7 @@ from typing import Iterator, List
 
 import pytest
 
-from rangebearing.cli import listen_cmd
+from rangebearing.cli import listen_cmd, swarm_cmd
 from rangebearing.cli.main import main
 from rangebearing.net.client import Subscriber
 from rangebearing.net.protocol import Reading, RemoteLandmark, decode_reading, encode_reading
@@ -127,8 +127,20 @@ def test_interface_needs_a_group(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 @pytest.mark.parametrize("argv", [["--port", "70000"], ["--count", "0"], ["--timeout", "-1"],
-                                  ["--timeout", "nan"], ["--port", "http"]])
+                                  ["--timeout", "nan"], ["--port", "http"], ["--timeout", "1e300"]])
 def test_bad_arguments_are_rejected_by_the_parser(argv: List[str]) -> None:
     with pytest.raises(SystemExit) as info:
         _parse(["listen", *argv])
+    assert info.value.code == 2
+
+
+@pytest.mark.parametrize("argv", [["--udp", "--port", "70000"], ["--udp", "--port", "-1"], ["--interval", "1e300"],
+                                  ["--duration", "1e300"]])
+def test_bad_swarm_arguments_are_rejected_by_the_parser(argv: List[str]) -> None:
+    """swarm --port 70000 was an OverflowError out of bind(), --duration 1e300 one out of time_t ('a bug?')."""
+    parser = argparse.ArgumentParser(prog="rangebearing")
+    swarm_cmd.register(parser.add_subparsers())
+    assert parser.parse_args(["swarm", "--udp", "--port", "0", "--duration", "1e9"]).duration == 1e9
+    with pytest.raises(SystemExit) as info:
+        parser.parse_args(["swarm", *argv])
     assert info.value.code == 2

@@ -258,8 +258,8 @@ def settings_from_args(args: argparse.Namespace, default_listen: Optional[str]) 
                          scouting_multicast=bool(args.scout))
 
 
-def positive(kind: type, unit: str = "") -> Any:
-    """An argparse ``type``: a finite number of ``kind`` above 0 (``unit`` names it in the message)."""
+def positive(kind: type, unit: str = "", most: float = math.inf) -> Any:
+    """An argparse ``type``: a finite number of ``kind`` above 0 and at most ``most`` (``unit`` names it)."""
 
     def parse(text: str) -> Any:
         try:
@@ -268,6 +268,8 @@ def positive(kind: type, unit: str = "") -> Any:
             raise argparse.ArgumentTypeError(f"{text!r} is not a {unit or kind.__name__}") from None
         if not value > 0 or (isinstance(value, float) and not math.isfinite(value)):
             raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+        if value > most:  # a timeout of 1e300 s overflowed time_t (an OverflowError, "a bug?")
+            raise argparse.ArgumentTypeError(f"must be at most {most:g}, got {text}")
         return value
 
     return parse

@@ -28,7 +28,11 @@ for daemons that dial it, or --connect to a router or a robot.
 """
 
 
-def _port(text: str) -> int:
+MAX_WAIT_S = 1e9  # ~32 years: any wait a user means; 1e300 s overflowed time_t
+
+
+def port_number(text: str) -> int:
+    """An argparse ``type``: a UDP port, 0-65535."""
     try:
         port = int(text)
     except ValueError:
@@ -46,7 +50,8 @@ def register(subparsers: Any) -> None:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--port", type=_port, default=DEFAULT_PORT, help=f"UDP port to listen on (default {DEFAULT_PORT})")
+    p.add_argument("--port", type=port_number, default=DEFAULT_PORT,
+                   help=f"UDP port to listen on (default {DEFAULT_PORT})")
     p.add_argument(
         "--host",
         default="127.0.0.1",
@@ -62,7 +67,7 @@ def register(subparsers: Any) -> None:
     p.add_argument("--count", type=positive(int), default=None, metavar="N", help="exit 0 after N readings")
     p.add_argument(
         "--timeout",
-        type=positive(float),
+        type=positive(float, most=MAX_WAIT_S),
         default=None,
         metavar="S",
         help="exit 1 if no reading arrives for S seconds (default: wait forever)",

@@ -10,6 +10,7 @@ from typing import Any, Callable, Optional, TextIO, Union
 from ..errors import TransportError
 from ..net.swarm import SwarmState, render
 from .common import DEFAULT_ZENOH_LISTEN, add_zenoh_args, positive, settings_from_args
+from .listen_cmd import MAX_WAIT_S, port_number
 
 DESCRIPTION = """\
 Show the whole swarm at a glance: one line per robot with its state (alive,
@@ -40,9 +41,9 @@ def register(subparsers: Any) -> None:
                               description=DESCRIPTION, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_zenoh_args(p, DEFAULT_LISTEN)
     p.add_argument("--udp", action="store_true", help="hear plain UDP readings instead of Zenoh")
-    p.add_argument("--port", type=int, default=None, help="UDP port with --udp (default 47800)")
+    p.add_argument("--port", type=port_number, default=None, help="UDP port with --udp (default 47800)")
     p.add_argument("--host", default="127.0.0.1", help="UDP address to bind with --udp (default 127.0.0.1)")
-    seconds = positive(float, "number of seconds")
+    seconds = positive(float, "number of seconds", most=MAX_WAIT_S)
     p.add_argument("--interval", type=seconds, default=None, metavar="S",
                    help="refresh every S seconds (default 0.5 on a terminal, 5 when piped)")
     p.add_argument("--duration", type=seconds, default=None, metavar="S", help="exit 0 after S seconds")
