@@ -322,3 +322,29 @@ def test_a_file_named_mcap_that_is_not_one_is_one_clear_error(
         assert status == 1 and "not an MCAP file" in said, said
         assert "retrying" not in said
         caplog.clear()
+
+
+@pytest.mark.parametrize("onto", ["the config", "a frame", "the recording's folder"])
+def test_run_never_records_over_what_it_reads(onto: str, tmp_path: Path, clip: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """``run --config c.yaml --record c.yaml`` replaced the config with an MCAP file and exited 0."""
+    frames = tmp_path / "frames"
+    shutil.copytree(clip, frames)
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text("detection: {max_landmarks: 8}\n")
+    target = {"the config": cfg, "a frame": next(frames.glob("*.png")), "the recording's folder": frames}[onto]
+    before = {p: p.read_bytes() for p in [cfg, *frames.iterdir()]}
+    status, _out, err = call(["run", "--config", str(cfg), "--source", str(frames), "--fps", "0",
+                              "--record", str(target)], capsys)
+    assert status == 1 and "--record: will not write" in error_line(err), err
+    assert {p: p.read_bytes() for p in [cfg, *frames.iterdir()]} == before
+
+
+@pytest.mark.parametrize("limit", [["--frames", "0"], ["--frames", "-1"], ["--seconds", "nan"], ["--seconds", "-1"],
+                                   ["--seconds", "1e300"]])
+def test_record_refuses_a_limit_that_records_nothing(limit: List[str], tmp_path: Path, clip: Path) -> None:
+    """record --frames 0 / --seconds nan recorded nothing and exited 0."""
+    with pytest.raises(SystemExit) as info:
+        main(["record", "--source", str(clip), *limit, "--out", str(tmp_path / "out"), "-q"])
+    assert info.value.code == 2
+    assert not (tmp_path / "out").exists()

@@ -26,10 +26,12 @@ from .common import (
     add_quiet_arg,
     add_source_args,
     config_from_args,
+    positive,
     progress,
     quiet_or_auto,
     source_from_args,
 )
+from .listen_cmd import MAX_WAIT_S
 from .outputs import check_output_dir, check_output_file, write_bytes_atomic
 
 
@@ -47,8 +49,10 @@ def register(sub: Any) -> None:
     p.add_argument("--readings", action="store_true",
                    help="with an MCAP --out: also run the pipeline and record each frame's reading")
     limit = p.add_mutually_exclusive_group(required=True)
-    limit.add_argument("--frames", type=int, metavar="N", help="stop after N frames")
-    limit.add_argument("--seconds", type=float, metavar="S", help="stop after S seconds")
+    # 0, -1 or nan recorded nothing and exited 0: a command-line error
+    limit.add_argument("--frames", type=positive(int, "number of frames"), metavar="N", help="stop after N frames")
+    limit.add_argument("--seconds", type=positive(float, "number of seconds", most=MAX_WAIT_S), metavar="S",
+                       help="stop after S seconds")
     p.add_argument("--format", choices=("png", "jpg"), default="png", help="image format (default png, lossless)")
     p.add_argument("--overwrite", action="store_true", help="write into a --out folder that is not empty")
     add_config_arg(p)

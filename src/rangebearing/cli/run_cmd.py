@@ -66,6 +66,11 @@ def recorder_for(args: argparse.Namespace, cfg: Config) -> Optional[Any]:
         raise ConfigError([f"--record-max-mb: at least {MIN_RECORD_MB:g} (MB), got {args.record_max_mb:g}: a smaller "
                            "file holds no frame whole, and rotating at each one keeps none"], "command line")
     from ..recording.background import BackgroundRecorder
+    from .outputs import check_output_file
+
+    # never over what the daemon reads: --record onto its --config replaced the config with an MCAP file
+    inputs = (getattr(args, "config", None), cfg.source.path if cfg.source.kind == "recorded" else None)
+    check_output_file(args.record, "--record", inputs, overwrite=True)
 
     max_bytes = None if args.record_max_mb is None else int(args.record_max_mb * 1e6)
     return BackgroundRecorder(args.record, cfg.camera, max_bytes=max_bytes, image_format=args.record_format,
