@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -83,7 +85,8 @@ finite = st.floats(-1e3, 1e3, allow_nan=False)
 @given(st.lists(st.tuples(st.integers(0, 999), st.floats(1e-3, 100), st.floats(-3.14, 3.14)), max_size=20))
 def test_round_trip_to_a_micro_unit(tmp_path_factory, items):
     path = tmp_path_factory.mktemp("t") / "truth.csv"
-    rows = [TruthRow(f"{i:06d}.png", r, b) for i, r, b in items]
+    written = {(i, f"{r:.6f}", f"{b:.6f}"): (i, r, b) for i, r, b in items}  # one landmark per place (no doubles)
+    rows = [TruthRow(f"{i:06d}.png", r, b) for i, r, b in written.values()]
     write_truth(path, rows)
     back = [row for frame_rows in read_truth(path).values() for row in frame_rows]
     assert sorted(r.frame for r in back) == sorted(r.frame for r in rows)
@@ -93,3 +96,16 @@ def test_round_trip_to_a_micro_unit(tmp_path_factory, items):
         for a, b in zip(want, got):
             assert b.range_m == pytest.approx(a.range_m, abs=5.1e-7)
             assert b.bearing_rad == pytest.approx(a.bearing_rad, abs=5.1e-7)
+
+
+@pytest.mark.parametrize("text, says", [
+    ("frame,range_m,bearing_rad\na.png,0.4,0.1\nb.png,0.5,0\na.png,0.4,0.1\n",
+     "truth.csv:4: the same landmark as line 2"),
+    ("frame,range_m,bearing_rad,range_m\na.png,0.4,0.1,0.5\n", "column(s) range_m given twice"),
+])
+def test_a_duplicated_row_or_column_is_refused(tmp_path: Path, text: str, says: str) -> None:
+    """A doubled row made the replay count its copy as missed; a doubled column kept the last value silently."""
+    path = tmp_path / "truth.csv"
+    path.write_text(text)
+    with pytest.raises(TruthError, match=re.escape(says)):
+        read_truth(path)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from typing import Dict, Iterable, List, Optional, Sequence, Union
+from typing import Dict, Iterable, List, Optional, Sequence, Tuple, Union
 
 from .._compat import frozen
 from ..errors import TruthError
@@ -141,6 +141,10 @@ def read_truth(path: PathLike) -> Dict[str, List[TruthRow]]:
                 raise TruthError(f"{name}:1: missing column(s) {', '.join(missing)} "
                                  f"(header is {','.join(header)!r})")
             reader.fieldnames = [h.strip() for h in header]
+            doubled = sorted({h for h in reader.fieldnames if reader.fieldnames.count(h) > 1})
+            if doubled:  # the reader would keep the last one silently
+                raise TruthError(f"{name}:1: column(s) {', '.join(doubled)} given twice")
+            seen: Dict[Tuple[str, float, float], str] = {}
             for rec in reader:
                 where = f"{name}:{reader.line_num}"
                 try:
@@ -148,6 +152,11 @@ def read_truth(path: PathLike) -> Dict[str, List[TruthRow]]:
                 except TruthError as exc:
                     problems.append(str(exc))
                     continue
+                key = (row.frame, row.range_m, row.bearing_rad)  # a second landmark there would be counted missed
+                if key in seen:
+                    problems.append(f"{where}: the same landmark as line {seen[key]} (a duplicated row)")
+                    continue
+                seen[key] = where.rsplit(":", 1)[1]
                 out.setdefault(row.frame, []).append(row)
     except OSError as exc:
         raise TruthError(f"{name}: cannot read: {exc.strerror or exc}") from None
