@@ -85,7 +85,8 @@ finite = st.floats(-1e3, 1e3, allow_nan=False)
 @given(st.lists(st.tuples(st.integers(0, 999), st.floats(1e-3, 100), st.floats(-3.14, 3.14)), max_size=20))
 def test_round_trip_to_a_micro_unit(tmp_path_factory, items):
     path = tmp_path_factory.mktemp("t") / "truth.csv"
-    written = {(i, f"{r:.6f}", f"{b:.6f}"): (i, r, b) for i, r, b in items}  # one landmark per place (no doubles)
+    # one landmark per place as read back (no doubles): keyed by the written text's value, so -0.000000 is 0.000000
+    written = {(i, float(f"{r:.6f}"), float(f"{b:.6f}")): (i, r, b) for i, r, b in items}
     rows = [TruthRow(f"{i:06d}.png", r, b) for i, r, b in written.values()]
     write_truth(path, rows)
     back = [row for frame_rows in read_truth(path).values() for row in frame_rows]
