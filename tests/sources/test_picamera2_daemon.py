@@ -9,7 +9,7 @@ import signal
 import subprocess
 import sys
 from pathlib import Path
-from typing import Dict
+from typing import Dict, Tuple
 
 import numpy as np
 
@@ -35,6 +35,20 @@ def start(tmp_path: Path, config: str, env: Dict[str, str]) -> subprocess.Popen:
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def three_true_readings_then_stop(proc: subprocess.Popen, sub: Subscriber) -> Tuple[int, str]:
+    """Three readings of the static scene, each checked against its truth, then SIGTERM: ``(exit code, stderr)``."""
+    try:
+        for _ in range(3):
+            check_truth(wait_reading(sub, "pi", timeout_s=TIMEOUT_S))
+        proc.send_signal(signal.SIGTERM)
+        code = proc.wait(timeout=TIMEOUT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        _, stderr = proc.communicate()
+    return code, stderr
+
+
 def test_the_daemon_publishes_true_readings_from_the_clean_room_camera(tmp_path: Path) -> None:
     from rangebearing.synth import render
 
@@ -46,15 +60,7 @@ def test_the_daemon_publishes_true_readings_from_the_clean_room_camera(tmp_path:
 source: {{kind: picamera2, fps: 30, timeout_s: 1.0}}
 publish: {{robot_id: pi, unicast: ["127.0.0.1:{sub.port}"]}}
 """, env)
-        try:
-            for _ in range(3):  # main RGB888 (padding-free at 640 px) measured, lores YUV420 searched
-                check_truth(wait_reading(sub, "pi", timeout_s=TIMEOUT_S))
-            proc.send_signal(signal.SIGTERM)
-            code = proc.wait(timeout=TIMEOUT_S)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-            _, stderr = proc.communicate()
+        code, stderr = three_true_readings_then_stop(proc, sub)  # main RGB888 measured, lores YUV420 searched
     assert code == 0, stderr
     assert "Traceback" not in stderr and "lores stream" not in stderr  # the lores stream was used, not refused
 

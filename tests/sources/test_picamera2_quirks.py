@@ -9,8 +9,6 @@ from __future__ import annotations
 import importlib.util
 import logging
 import os
-import signal
-import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -188,7 +186,7 @@ def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path) -> None:
     from rangebearing.net.client import Subscriber
     from rangebearing.synth import render
     from tests.conftest import STATIC_SCENE
-    from tests.daemon.test_e2e import check_truth, wait_reading
+    from tests.sources.test_picamera2_daemon import start, three_true_readings_then_stop
 
     np.save(tmp_path / "scene.npy", np.ascontiguousarray(render(STATIC_SCENE, np.random.default_rng(3))[:, :, ::-1]))
     site = tmp_path / "site" / "picamera2"
@@ -199,22 +197,11 @@ def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path) -> None:
            "PICAMERA2_QUIRKS": "no_wait,no_metadata,release_fails,flush_fails,xbgr,lores_unpadded,close_fails",
            "PICAMERA2_SCENE": str(tmp_path / "scene.npy")}
     with Subscriber(port=0, timeout_s=TIMEOUT_S) as sub:
-        (tmp_path / "config.yaml").write_text(f"""
+        proc = start(tmp_path, f"""
 source: {{kind: picamera2, fps: 30, timeout_s: 1.0}}
 publish: {{robot_id: pi, unicast: ["127.0.0.1:{sub.port}"]}}
-""")
-        proc = subprocess.Popen([sys.executable, "-m", "rangebearing.cli.main", "run", "--config",
-                                 str(tmp_path / "config.yaml")], env=env, stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)
-        try:
-            for _ in range(3):
-                check_truth(wait_reading(sub, "pi", timeout_s=TIMEOUT_S))
-            proc.send_signal(signal.SIGTERM)
-            code = proc.wait(timeout=TIMEOUT_S)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-            _, stderr = proc.communicate()
+""", env)
+        code, stderr = three_true_readings_then_stop(proc, sub)
     assert code == 0, stderr
     assert "Traceback" not in stderr, stderr
     assert 1 <= stderr.count("release failed") <= 2, stderr  # once a camera opened (a reopen may say it again)
