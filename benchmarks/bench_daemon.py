@@ -15,6 +15,7 @@ one-core affinity.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -22,6 +23,7 @@ import re
 import shutil
 import signal
 import socket
+import struct
 import subprocess
 import sys
 import tempfile
@@ -54,7 +56,7 @@ class DaemonFigures:
     seq_gaps: int  # frames missing between consecutive seq numbers (lost datagrams)
     cpu_pct: float  # of one core, over the window
     cpu_ms_per_frame: float
-    latency_ms_p50: float
+    latency_ms_p50: float  # capture -> send: the datagram's kernel stamp (SO_TIMESTAMPNS) minus its t
     latency_ms_p99: float
     latency_ms_max: float
     rss_mib: float
@@ -66,6 +68,8 @@ class DaemonFigures:
     tracked_pct: float = float("nan")  # frames the pipeline tracked rather than scanned whole
     bytecode: bool = True  # the package's modules were compiled beforehand, as an installed package's are
     restart: bool = True  # a start after a first one with the same config (the package's cache filled)
+    received_ms_p99: float = float("nan")  # capture -> the listener's thread (its own wait for a core included)
+    kernel_stamped: bool = False  # latency is capture -> send (else capture -> received)
     clip_mib: float = float("nan")  # the recorded clip decoded (frames and their YUV420): in the page cache, not RSS
 
 
@@ -106,15 +110,35 @@ def _status_kib(pid: int, key: str) -> float:
     return float("nan")
 
 
+SO_TIMESTAMPNS = 35  # Linux (asm-generic, x86, arm): the kernel stamps each datagram as it is queued (ns)
+
+
+def _kernel_stamp(ancdata: Sequence[Tuple[int, int, bytes]]) -> float:
+    """The ``SCM_TIMESTAMPNS`` of a ``recvmsg`` (wall clock, s), or NaN where the kernel gave none."""
+    for level, kind, data in ancdata:
+        if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(data) in (8, 16):
+            sec, ns = struct.unpack("qq" if len(data) == 16 else "ii", data)
+            return sec + ns / 1e9
+    return float("nan")
+
+
 class Listener:
-    """Receives datagrams on 127.0.0.1, keeping (arrival wall time, arrival monotonic ns, message)."""
+    """Receives datagrams on 127.0.0.1, keeping (arrival wall time, arrival monotonic s, sent wall time, message).
+
+    The sent time is the kernel's stamp of the datagram (``SO_TIMESTAMPNS``): on loopback it is taken in
+    the daemon's own ``send`` call, so latency measured with it is capture → send, whatever this
+    listener's thread waits for a core (pinned beside the daemon it waits for the daemon's work after the
+    send: the full scan, the next frame). NaN where the kernel does not stamp (the arrival is used then).
+    """
 
     def __init__(self) -> None:
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.sock.bind(("127.0.0.1", 0))
         self.sock.settimeout(0.2)
+        with contextlib.suppress(OSError):  # no stamps: latency is then as received
+            self.sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
         self.port = self.sock.getsockname()[1]
-        self.got: List[Tuple[float, float, dict]] = []
+        self.got: List[Tuple[float, float, float, dict]] = []
         self.first = threading.Event()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, daemon=True)
@@ -123,12 +147,12 @@ class Listener:
     def _run(self) -> None:
         while not self._stop.is_set():
             try:
-                data = self.sock.recv(65536)
+                data, ancdata, _, _ = self.sock.recvmsg(65536, socket.CMSG_SPACE(16))
             except OSError:
                 continue
             now, mono = time.time(), time.perf_counter()
             try:
-                self.got.append((now, mono, json.loads(data)))
+                self.got.append((now, mono, _kernel_stamp(ancdata), json.loads(data)))
             except ValueError:
                 continue
             self.first.set()
@@ -221,8 +245,11 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
                                  f"{error}; log: {tail}", bytecode=bytecode, restart=restart)
     summary = _SUMMARY.search(tail)
     window = listener.got[n0:n1]
-    lat = np.array([(arr - msg["t"]) * 1e3 for arr, _, msg in window]) if window else np.array([np.nan])
-    seqs = [msg["seq"] for _, _, msg in listener.got]
+    # capture -> send by the kernel's stamp (capture -> this listener's thread where there is none)
+    lat = np.array([((arr if sent != sent else sent) - msg["t"]) * 1e3 for arr, _, sent, msg in window]
+                   if window else [np.nan])
+    received = np.array([(arr - msg["t"]) * 1e3 for arr, _, _, msg in window] if window else [np.nan])
+    seqs = [msg["seq"] for _, _, _, msg in listener.got]
     gaps = sum(max(0, b - a - 1) for a, b in zip(seqs, seqs[1:]))
     cpu = (c1 - c0) / (w1 - w0)
     return DaemonFigures(
@@ -231,7 +258,7 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         startup_s=startup,
         frames_expected=round(fps * (w1 - w0)),
         received=n1 - n0,
-        dropped=int(window[-1][2].get("dropped", 0)) - int(listener.got[max(0, n0 - 1)][2].get("dropped", 0))
+        dropped=int(window[-1][3].get("dropped", 0)) - int(listener.got[max(0, n0 - 1)][3].get("dropped", 0))
         if window else 0,
         seq_gaps=gaps,
         cpu_pct=100.0 * cpu,
@@ -239,6 +266,8 @@ def daemon_run(cfg: Config, frames: Sequence[np.ndarray], fps: float, duration_s
         latency_ms_p50=float(np.percentile(lat, 50)),
         latency_ms_p99=float(np.percentile(lat, 99)),
         latency_ms_max=float(lat.max()),
+        received_ms_p99=float(np.percentile(received, 99)),
+        kernel_stamped=bool(window) and all(sent == sent for _, _, sent, _ in window),
         rss_mib=rss / 1024.0,
         rss_peak_mib=hwm / 1024.0,
         exit_code=code,
@@ -292,8 +321,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     cfg, frames = bench_clip(args.frames)
     modes = {"auto": ("auto",), "off": (False,), "on": (True,), "both": (False, True)}[args.scan_after_send]
     print("| fps | scan after send | bytecode | start-up s (CPU s) | datagrams / due | dropped | gaps | CPU % "
-          "| CPU ms/frame | pipeline ms/frame (tracked) | rest ms/frame | p50 / p99 / max ms | RSS / peak MiB | load |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| CPU ms/frame | pipeline ms/frame (tracked) | rest ms/frame | capture→send p50 / p99 / max ms "
+          "| →received p99 ms | RSS / peak MiB | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for fps in args.fps:
         for _, later in ((run, later) for run in range(args.runs) for later in modes):
             seconds = args.seconds or (10.0 if fps <= 30 else 5.0)
@@ -308,7 +338,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                   f"| {d.received} / {d.frames_expected} | {d.dropped} | {d.seq_gaps} | {d.cpu_pct:.2f} "
                   f"| {d.cpu_ms_per_frame:.3f} | {d.pipeline_cpu_ms:.3f} ({d.tracked_pct:.0f} %) "
                   f"| {d.cpu_ms_per_frame - d.pipeline_cpu_ms:.3f} "
-                  f"| {d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / {d.latency_ms_max:.2f} "
+                  f"| {d.latency_ms_p50:.2f} / {d.latency_ms_p99:.2f} / {d.latency_ms_max:.2f}"
+                  f"{'' if d.kernel_stamped else ' (as received)'} | {d.received_ms_p99:.2f} "
                   f"| {d.rss_mib:.0f} / {d.rss_peak_mib:.0f} (clip {d.clip_mib:.0f} in page cache) "
                   f"| {os.getloadavg()[0]:.2f} |",
                   flush=True)

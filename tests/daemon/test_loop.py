@@ -312,6 +312,7 @@ def test_freeze_gc_moves_start_up_objects_out_of_the_collector(static_clip):
         assert gc.get_freeze_count() > 1000
     finally:
         gc.unfreeze()
+        gc.set_threshold(700, 10, 10)
 
 
 def test_the_collector_paused_while_starting_runs_again_after_the_first_frame(static_clip):
@@ -328,6 +329,7 @@ def test_the_collector_paused_while_starting_runs_again_after_the_first_frame(st
     finally:
         gc.enable()
         gc.unfreeze()
+        gc.set_threshold(700, 10, 10)
 
 
 def test_run_never_leaves_the_collector_off(tmp_path):

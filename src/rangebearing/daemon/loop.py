@@ -15,7 +15,6 @@ aspect ratio; a frame of another size after good ones is skipped and counted).
 from __future__ import annotations
 
 import dataclasses
-import gc
 import logging
 import signal
 import threading
@@ -33,6 +32,7 @@ from ..net.publisher import Publisher
 from ..sources.base import Frame, FrameSource, kept
 from .capture import CaptureGuard
 from .housekeeping import Housekeeping, ServiceManager
+from .process import Collector, precise_wakeups
 from .recorder import NoRecorder, Recorder
 from .reload import Reloading
 from .stats import LoopStats, Summary
@@ -74,8 +74,9 @@ class Daemon(Reloading):
     recorder : Recorder, optional
         Given every frame with the reading sent for it (``run --record``); closed when the loop ends.
     freeze_gc : bool
-        After the first frame, ``gc.freeze`` every object alive (modules, config, tables: never garbage, and
-        a collection that rescans them is a pause in its frame). For ``rangebearing run``'s own process.
+        ``rangebearing run``'s own process (:mod:`.process`): after the first frame, ``gc.freeze`` every object
+        alive (modules, config, tables: never garbage), then collect after each send, never inside a frame's
+        capture → send; and wake-ups without timer slack.
     """
 
     def __init__(
@@ -91,7 +92,7 @@ class Daemon(Reloading):
         freeze_gc: bool = False,
     ) -> None:
         self.cfg = cfg
-        self._freeze_gc = freeze_gc
+        self._collector = Collector() if freeze_gc else None
         self._open_source = open_source
         self._open_publisher = open_publisher
         self._reload_config = reload
@@ -143,6 +144,8 @@ class Daemon(Reloading):
     def run(self) -> int:
         """0: the source ended or a stop was requested; 1: the camera is gone; 2: frames the config cannot fit."""
         self._publisher = self._open_publisher(self.cfg)
+        if self._collector is not None:
+            precise_wakeups()  # a paced frame's sleep ends when it is due, not up to 50 µs later
         try:
             if not self.guard.open():
                 return 0  # stopped while the camera was still being waited for
@@ -203,9 +206,8 @@ class Daemon(Reloading):
                 self.recorder.add(kept(frame), frame.index, payload, t_unix)  # the recorder's thread keeps it
             first = not self.house.ready
             self.house.frame_done(t2, frame.image.shape[1], frame.image.shape[0])
-            if first and self._freeze_gc:
-                gc.freeze()
-                gc.enable()  # `run` keeps the collector off while starting (cli.main)
+            if self._collector is not None:  # start-up frozen; garbage collected now its datagram is out
+                self._collector.frame_sent(first)
             if self.view is not None and self.view.wants(t2):  # only while a browser watches, at its rate
                 status = dataclasses.asdict(self.summary())
                 self.view.offer(t2, kept(frame), frame.name, result, self.cfg.detection, status)
