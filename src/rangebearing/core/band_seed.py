@@ -84,20 +84,30 @@ def body_side(p: np.ndarray, band: BandEdges, red: bool, hb: float) -> BandEdges
     colour than it (an orange brick wall behind a crimson band, a cyan wall behind a navy
     one), and its edge was the band's outer one: the band is the darker run between it and the body,
     its inner edge where the luma rises to the body within ``1.5·hb + 2`` rows (half-level crossing).
-    Placed as merged all the same. Bands seen whole, or with no such rise, are returned unchanged.
+    Where the luma neither rises nor falls across the edge, the edge sits inside the band (the seed's run
+    went on into a dim band before a redder wall) or inside the body (the chroma bled 2-4 rows into it):
+    the search then starts a band's height on the band's side, past the band's darkest rows, and the band
+    is placed the same way. Placed as merged all the same. Bands seen whole, bands whose luma rises across
+    the edge (the body's) or with no such rise are returned unchanged.
     """
     s, n = (1 if red else -1), len(p)
     a, b = round(band.inner - 1.5 * s), round(band.inner + 1.5 * s)  # a row on each side of the edge
-    if not band.merged or not (min(a, b) >= 0 and max(a, b) < n) or BODY_RISE * p[b] >= p[a]:
-        return band
+    if not band.merged or not (min(a, b) >= 0 and max(a, b) < n) or p[b] >= BODY_RISE * p[a]:
+        return band  # the luma rises across the edge: the body's
+    # it falls (the seed's run ended at the band's outer edge) or stays level (it ended inside the band or
+    # the body): the search then starts a band's height on the band's side, past its darkest rows
+    falls = BODY_RISE * p[b] < p[a]
+    start = b if falls else min(n - 1, max(0, round(band.inner - s * hb)))
     end = min(n - 1, max(0, round(band.inner + s * (1.5 * hb + 2))))
-    seg = p[b : end + 1] if red else p[end : b + 1][::-1]  # from the edge into the body
+    seg = p[start : end + 1] if red else p[end : start + 1][::-1]  # from the edge into the body
     k = int(np.argmin(seg))
     low, white = float(seg[k]), float(seg[k:].max())
     if not white > BODY_RISE * max(low, 1e-6):
         return band
     half = 0.5 * (low + white)
     j = k + int(np.argmax(seg[k:] >= half))  # the first row at half the body's luma, past the band's darkest
+    if j == 0:
+        return band
     x = j - 1 + float((half - seg[j - 1]) / (seg[j] - seg[j - 1]))  # ... interpolated from the row before
-    inner = b + s * x
+    inner = start + s * x
     return dataclasses.replace(band, inner=inner, centre=inner)
