@@ -196,16 +196,16 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
     b_exp = (by + 0.5 * bh - oy) / f - 0.5
     red = _band(er, mean_along(er, 1), r_exp, hb, hw, True, column_sigma)
     blue = _band(eb, mean_along(eb, 1), b_exp, hb, hw, False, column_sigma)
-    if red is not None and blue is not None and lu is not None:  # a merged band's edge must be the body's
-        red, blue = body_side(mean_along(lu, 1), red, True, hb), body_side(mean_along(lu, 1), blue, False, hb)
+    lp = None if lu is None or red is None or blue is None else mean_along(lu, 1)  # a merged band's edge: the body's
+    red, blue = (red, blue) if lp is None else (body_side(lp, red, True, hb), body_side(lp, blue, False, hb))
     if red is None or blue is None or not blue.inner > red.inner:
         return None
     white, k = blue.inner - red.inner, 0.5 * geometry.band_height_m / white_m
     cw, tol = c.white_px / f, WHITE_MATCH * c.white_px / f  # inner edges (chroma or luma) this close: the body's
     blue = _hidden(blue, _height(red, True) or 2 * k * white) if abs(white - cw) <= tol else blue
     luma = (False, False)
-    if lu is not None and not (red.merged and blue.merged):
-        l_red, l_blue, l_white = _luma_edges(mean_along(lu, 1), red, blue, 2 * k * white)
+    if lp is not None and not (red.merged and blue.merged):
+        l_red, l_blue, l_white = _luma_edges(lp, red, blue, 2 * k * white)
         l_blue = _hidden(l_blue, _height(l_red, True) or 2 * k * l_white) if abs(l_white - cw) <= tol else l_blue
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them

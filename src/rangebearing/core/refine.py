@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import CLIPPED, Gains, apply_gains, hue_table, ramp_table, sv_gate, to_hsv
+from .color import CLIPPED, Gains, apply_gains, hue_table, ramp_table, to_hsv
 from .params import DetectionParams
 from .types import XY, BBox
 
@@ -74,7 +74,11 @@ def band_weights(
         cv2.LUT(hue[:split], hue_table(cfg.red_hue), dst=gate[:split])
     if split < n * h:
         cv2.LUT(hue[split:], hue_table(cfg.blue_hue), dst=gate[split:])
-    gate = cv2.bitwise_and(gate, sv_gate(sat, val, 1, min(cfg.v_min, 10)))
+    # :func:`.color.sv_gate` at S ≥ 1, V ≥ min(v_min, 10): (S ≥ 1 or V clipped) and V ≥ that floor (a clipped
+    # V is above it), in three thresholds instead of four, the clipped one kept for ``w_x``
+    clip = cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]
+    lit = cv2.threshold(val, min(cfg.v_min, 10) - 1, 255, cv2.THRESH_BINARY)[1]
+    gate = cv2.bitwise_and(gate, cv2.bitwise_and(cv2.max(cv2.threshold(sat, 0, 255, cv2.THRESH_BINARY)[1], clip), lit))
     core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])
     count = np.maximum(_tile_sums(core, n) / 255.0, 1.0)
     # brightness relative to the band: a dark, faintly tinted pedestal or shadow next to it is no band
@@ -84,7 +88,7 @@ def band_weights(
     v_gate = np.multiply(val.reshape(n, -1) >= v_least, np.uint8(255), dtype=np.uint8).reshape(n * h, w)
     w_x = cv2.LUT(sat, ramp_table(max(0, cfg.s_min - S_RAMP), 2 * S_RAMP))
     # a clipped highlight (a spotlight's vertical streak) keeps its hue but loses saturation: full weight
-    w_x = cv2.bitwise_and(cv2.max(w_x, cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]), gate)
+    w_x = cv2.bitwise_and(cv2.max(w_x, clip), gate)
     # only rows need the brightness gate (a pedestal lies below the band; the dark limb must stay for x)
     chroma = cv2.bitwise_and(cv2.multiply(sat, val, scale=1.0 / 255.0), cv2.bitwise_and(gate, v_gate))
     if refs is None:
@@ -94,7 +98,8 @@ def band_weights(
     w_y = chroma.reshape(n, h * w).astype(np.float32)
     w_y -= floor
     w_y /= np.maximum(ref - floor, np.float32(1e-3))  # a tile with no core has ref 0 and weighs nothing
-    np.clip(w_y, 0.0, 1.0, out=w_y)  # outside the gate chroma is 0, so the weight is 0
+    np.maximum(w_y, np.float32(0.0), out=w_y)  # np.clip's values, without its Python layer;
+    np.minimum(w_y, np.float32(1.0), out=w_y)  # outside the gate chroma is 0, so the weight is 0
     return w_x.reshape(n, h, w), w_y.reshape(n, h, w), ref[:, 0]
 
 
