@@ -37,15 +37,17 @@ def test_every_rgb_layout_the_camera_may_grant_reads_as_bgr(fake_picamera2: Modu
     assert (image[..., 2] == 255).all() and (image[..., :2] == 0).all()  # red, and no padding (77) read
 
 
-def test_a_main_stream_that_is_not_rgb_is_a_clear_error_and_frees_the_camera(fake_picamera2: ModuleType) -> None:
+@pytest.mark.parametrize("fmt", ["SRGGB10_CSI2P", "R8", "P010"])  # raw Bayer, mono, a format picamera2 lacks
+def test_a_main_stream_in_no_colour_format_is_a_clear_error_and_frees_the_camera(fake_picamera2: ModuleType,
+                                                                                 fmt: str) -> None:
     world = fake_picamera2.WORLD
-    world.adjusted = {"main": {"format": "YUYV"}}
-    fake_picamera2._BYTES_PER_PIXEL["YUYV"] = 2  # the fake knows the format only for this test
+    world.adjusted = {"main": {"format": fmt}}
+    fake_picamera2._BYTES_PER_PIXEL[fmt] = 2  # the fake knows the format only for this test
     try:
-        with pytest.raises(CameraError, match=r"main stream as 'YUYV'.*source\.kind: opencv"):
+        with pytest.raises(CameraError, match=rf"main stream as '{fmt}'.*source\.kind: opencv"):
             Picamera2Source(make_cfg(retries=1), sleep=Sleeps()).open()
     finally:
-        del fake_picamera2._BYTES_PER_PIXEL["YUYV"]
+        del fake_picamera2._BYTES_PER_PIXEL[fmt]
     assert world.open_cameras == set()  # closed again: the next attempt can have it
 
 

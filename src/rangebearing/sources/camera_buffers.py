@@ -16,6 +16,7 @@ import numpy as np
 from ..core.yuv import Yuv420, yuv420_planes
 from ..errors import CameraError
 from .camera_capture import Notes
+from .camera_formats import DECODED, decode_main
 
 _log = logging.getLogger(__name__)
 
@@ -55,7 +56,15 @@ class Held:
                 array = getattr(m, "array", None)
                 if array is not None:
                     return array
-        return self.request.make_array(stream)
+        try:
+            return self.request.make_array(stream)
+        except Exception as exc:  # a format make_array cannot shape ("Format NV12 not supported"): its bytes
+            make_buffer = getattr(self.request, "make_buffer", None)
+            if make_buffer is None:
+                raise
+            self._notes.once("buffer-" + stream, "make_array(%r) failed (%s): reading its bytes with make_buffer",
+                             stream, exc)
+            return make_buffer(stream)
 
     @property
     def mapped(self) -> Any:
@@ -111,12 +120,23 @@ class Layout:
     """
 
     def __init__(self, width_px: int, channels: slice, lores_size: Optional[Tuple[int, int]], swap_uv: bool,
-                 colour_space: str, camera_num: int, height_px: int = 0, bytes_per_px: int = 3) -> None:
+                 colour_space: str, camera_num: int, height_px: int = 0, bytes_per_px: int = 3,
+                 main_format: str = "RGB888") -> None:
         self.width_px, self.channels = width_px, channels
         self.height_px, self.bytes_per_px = height_px, bytes_per_px
         self.lores_size, self.swap_uv, self.colour_space = lores_size, swap_uv, colour_space
+        self.main_format = main_format  # one of _TO_BGR (read in place) or camera_formats.DECODED (converted)
         self._camera_num = camera_num
         self._warned = False
+
+    def main(self, array: Any) -> Tuple[Any, Optional[Yuv420]]:
+        """The main stream as B, G, R, and its own YUV420 planes if it is YUV420 (else None).
+
+        FrameError if a main stream granted in a converted format cannot be read.
+        """
+        if self.main_format in DECODED:
+            return decode_main(array, self.main_format, self.width_px, self.height_px, self.colour_space)
+        return self.bgr(array), None
 
     def bgr(self, array: Any) -> Any:
         """The main stream's pixels as B, G, R (a view; padding columns of an old ``make_array`` cut off).
@@ -143,8 +163,11 @@ class Layout:
         """The Y, U, V planes of a lores buffer (views), or None: then the main image is searched instead."""
         if buffer is None or self.lores_size is None:
             return None
+        w, h = self.lores_size
+        if isinstance(buffer, np.ndarray) and buffer.ndim == 1 and h > 1 and buffer.size % (h * 3 // 2) == 0:
+            buffer = buffer.reshape(h * 3 // 2, -1)  # make_buffer's one run of bytes: rows of its stride
         try:
-            yuv = yuv420_planes(buffer, self.lores_size[0], self.lores_size[1], self.colour_space)
+            yuv = yuv420_planes(buffer, w, h, self.colour_space)
         except (ValueError, TypeError, AttributeError) as exc:  # an odd buffer: say so once, search the main image
             if not self._warned:
                 _log.warning("camera %d: lores stream unusable, searching the main image: %s", self._camera_num, exc)
@@ -154,20 +177,21 @@ class Layout:
 
 
 def granted(active: Dict[str, Any], camera_num: int) -> Layout:
-    """The :class:`Layout` of a configured camera; CameraError if its main stream is not RGB in some order."""
+    """The :class:`Layout` of a configured camera; CameraError if its main stream is in no colour format we read."""
     main = active["main"]
     fmt = str(main.get("format", "RGB888"))
-    if fmt not in _TO_BGR:
+    if fmt not in _TO_BGR and fmt not in DECODED:
         raise CameraError(f"camera {camera_num}: the camera gives its main stream as {fmt!r}, not one of "
-                          f"{', '.join(_TO_BGR)} (not a Raspberry Pi camera? use source.kind: opencv)")
+                          f"{', '.join([*_TO_BGR, *sorted(DECODED)])} (not a Raspberry Pi camera? use "
+                          "source.kind: opencv)")
+    if "colour_space" in active:
+        matrix = _matrix(active["colour_space"])
+    else:  # not reported: picamera2's video default (create_video_configuration), by the main size
+        big = int(main["size"][0]) >= 1280 and int(main["size"][1]) >= 720
+        matrix = "rec709" if big else "smpte170m"
     lores = active.get("lores")
-    size, swap, matrix = None, False, "smpte170m"
+    size, swap = None, False
     if lores:
-        if "colour_space" in active:
-            matrix = _matrix(active["colour_space"])
-        else:  # not reported: picamera2's video default (create_video_configuration), by the main size
-            big = int(main["size"][0]) >= 1280 and int(main["size"][1]) >= 720
-            matrix = "rec709" if big else "smpte170m"
         lores_fmt = str(lores.get("format"))
         same_size = [int(v) for v in lores.get("size", ())] == [int(v) for v in main["size"]]
         if not same_size:  # the search reads the lores planes at the main image's scale (its U, V at half)
@@ -176,11 +200,12 @@ def granted(active: Dict[str, Any], camera_num: int) -> Layout:
         elif lores_fmt not in ("YUV420", "YVU420") or matrix is None:
             _log.warning("camera %d: lores stream granted as %s in colour space %s, which the search cannot read: "
                          "searching the main image instead", camera_num, lores_fmt, active.get("colour_space"))
-            matrix = "smpte170m"
         else:
             size, swap = (int(lores["size"][0]), int(lores["size"][1])), lores_fmt == "YVU420"
-    return Layout(int(main["size"][0]), _TO_BGR[fmt], size, swap, matrix, camera_num, int(main["size"][1]),
-                  4 if fmt.startswith("X") else 3)
+    if matrix is None:  # a colour space we do not know: the usual one (only a Y'CbCr main stream is read with it)
+        matrix = "smpte170m"
+    return Layout(int(main["size"][0]), _TO_BGR.get(fmt, slice(0, 3)), size, swap, matrix, camera_num,
+                  int(main["size"][1]), 4 if fmt.startswith("X") else 3, fmt)
 
 
 def _matrix(colour_space: Any) -> Optional[str]:

@@ -92,8 +92,11 @@ def create_configuration(cam: Any, cfg: SourceConfig, libcamera: Any) -> Dict[st
     gets the core keywords only (its colour space is read from what it grants; flips then need it: CameraError).
     """
     kwargs = video_configuration(cfg, libcamera)
+    create = _config_maker(cam, cfg.camera_num)
+    if create is None:  # a stand-in with configure() only: the dict picamera2 would have made, by hand
+        return {"use_case": "video", **kwargs, "raw": None, "queue": True}
     try:
-        return cam.create_video_configuration(**kwargs)
+        return create(**kwargs)
     except TypeError:
         if "colour_space" not in kwargs:
             raise
@@ -101,25 +104,39 @@ def create_configuration(cam: Any, cfg: SourceConfig, libcamera: Any) -> Dict[st
         raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need create_video_configuration(transform=)")
     _log.warning("camera %d: create_video_configuration() takes no colour_space/transform: the camera's own",
                  cfg.camera_num)
-    return cam.create_video_configuration(**video_configuration(cfg, None))
+    return create(**video_configuration(cfg, None))
+
+
+def _config_maker(cam: Any, camera_num: int) -> Any:
+    """``create_video_configuration``, else the preview or still one (same keywords), else None."""
+    for name in ("create_video_configuration", "create_preview_configuration", "create_still_configuration"):
+        create = getattr(cam, name, None)
+        if callable(create):
+            if name != "create_video_configuration":
+                _log.warning("camera %d: no create_video_configuration(): using %s()", camera_num, name)
+            return create
+    _log.warning("camera %d: no create_*_configuration(): configuring with a dict of our own", camera_num)
+    return None
 
 
 def granted_configuration(cam: Any, asked: Dict[str, Any]) -> Dict[str, Any]:
     """The configuration the camera runs with: ``camera_configuration()``, else per stream, else what was asked.
 
-    Every picamera2 since 0.3 has ``camera_configuration()``; without it the
-    streams come from ``stream_configuration(name)``; without both, the dict
+    Every picamera2 since 0.3 has ``camera_configuration()`` (it returns the
+    ``camera_config`` attribute, read next); without them the streams come from
+    ``stream_configuration(name)``; without all three, the dict
     passed to ``configure()`` (whose stream dicts the real ``configure`` fills in
     with the granted size, format and stride: it copies the outer dict only).
     """
-    try:
-        active = cam.camera_configuration()
+    for read in (lambda: cam.camera_configuration(), lambda: cam.camera_config):  # the first returns the second
+        try:
+            active = read()
+        except (AttributeError, TypeError, RuntimeError, KeyError):
+            continue
         if isinstance(active, dict) and isinstance(active.get("main"), dict):
             if "colour_space" not in active and "colour_space" in asked:
                 return {**active, "colour_space": asked["colour_space"]}
             return active
-    except (AttributeError, TypeError, RuntimeError, KeyError):
-        pass
     streams: Dict[str, Any] = {}
     try:
         for name in ("main", "lores"):

@@ -215,8 +215,13 @@ class Picamera2Source:
         lores = self._lores(held) if layout.lores_size else None  # type: ignore[union-attr]
         self._budget.frame_arrived()
         self._metadata = metadata
-        image = validate_frame(layout.bgr(array))  # type: ignore[union-attr]  # a view if contiguous, else a copy
-        search = layout.planes(lores)  # type: ignore[union-attr]
+        try:
+            image, own_planes = layout.main(array)  # type: ignore[union-attr]
+            image = validate_frame(image)  # a view if contiguous, else a copy
+        except FrameError:
+            self._release_held()
+            raise
+        search = layout.planes(lores) if lores is not None else own_planes  # type: ignore[union-attr]
         if not self._in_place:  # the caller may keep the frame: copy it out, give the buffers back now
             image = image if image.flags.owndata else image.copy()
             search = copied(search)

@@ -22,6 +22,18 @@ library documents or has done:
 - ``flat_main``: the main stream as its (H, stride) rows; ``flat_bytes``: as one run of bytes (``make_buffer``).
 - ``open_fails``: the first ``Picamera2()`` raises OSError (ENODEV); ``start_fails``: the first ``start()``
   raises ValueError.
+- the main stream granted in another format than RGB888 (libcamera's ``validate()``; request.py
+  ``_make_array_shared`` layouts): ``yuv420_main`` (H·3/2, stride), ``nv12_main`` (which ``make_array``
+  cannot shape: "Format NV12 not supported", only ``make_buffer`` gives it), ``yuyv_main`` (H, stride/2, 2),
+  ``rgb16_main`` (RGB161616: (H, W, 3) uint16), ``mjpeg_main`` (decoded to R, G, B as PIL does),
+  ``mjpeg_bytes`` (``make_array`` gives the JPEG bytes, as a fake without PIL would).
+- ``make_buffer_fails``: ``make_buffer`` raises too (with ``make_array_fails``: a main stream nothing can read).
+- ``config_attr_only``: no ``camera_configuration()`` / ``stream_configuration()``, only the ``camera_config``
+  attribute; ``configure()`` deep-copies what it is given (so the asked dict says nothing) and grants XBGR8888.
+- ``preview_only``: no ``create_video_configuration`` (``create_preview_configuration`` only);
+  ``no_create``: no ``create_*_configuration`` at all (``configure(dict)`` only).
+- ``aligned``: ``configure()`` applies ``align_configuration(optimal=True)`` (VC4: widths down to 32 px,
+  YUV420 64, XBGR8888 16; heights even), so the size granted is not the one asked.
 
 ``SCENE(sequence) -> (H, W, 3)`` gives the frames in TRUE (R, G, B) order; ``STALLED`` makes captures wait.
 """
@@ -29,10 +41,12 @@ library documents or has done:
 from __future__ import annotations
 
 import concurrent.futures
+import copy
 import os
 import threading
 from typing import Any, Callable, Dict, List, Optional
 
+import cv2
 import numpy as np
 
 QUIRKS: set = set()
@@ -98,6 +112,50 @@ def _rgb_to_yuv420(rgb: np.ndarray, stride: int) -> np.ndarray:
     return out
 
 
+# quirk -> the main format configure() grants
+MAIN_GRANTS = {"xbgr": "XBGR8888", "config_attr_only": "XBGR8888", "yuv420_main": "YUV420", "nv12_main": "NV12",
+               "yuyv_main": "YUYV", "rgb16_main": "RGB161616", "mjpeg_main": "MJPEG", "mjpeg_bytes": "MJPEG"}
+BYTES_PER_PX = {"RGB888": 3, "XBGR8888": 4, "YUV420": 1, "NV12": 1, "YUYV": 2, "RGB161616": 6, "MJPEG": 1}
+ALIGN = {"XBGR8888": 16, "RGB161616": 16, "YUV420": 64}  # align_stream on VC4 (picamera2.py 1087-1100), else 32
+
+
+def _rgb_to_ycbcr(rgb: np.ndarray) -> tuple:
+    r, g, b = (rgb[..., i].astype(np.float64) for i in range(3))
+    y = 16 + (65.481 * r + 128.553 * g + 24.966 * b) / 255
+    u = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255
+    v = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255
+    return tuple(np.clip(np.rint(c), 0, 255).astype(np.uint8) for c in (y, u, v))
+
+
+def _main_buffer(rgb: np.ndarray, fmt: str, stride: int) -> np.ndarray:
+    """The main stream's bytes as the camera would lay them out (rows of ``stride`` bytes; MJPEG: the file)."""
+    h, w = rgb.shape[:2]
+    if fmt == "YUV420":
+        return _rgb_to_yuv420(rgb, stride)
+    if fmt == "MJPEG":
+        ok, jpeg = cv2.imencode(".jpg", np.ascontiguousarray(rgb[..., ::-1]), [cv2.IMWRITE_JPEG_QUALITY, 95])
+        assert ok
+        return jpeg.reshape(-1)
+    y, u, v = _rgb_to_ycbcr(rgb)
+    if fmt == "NV12":
+        out = np.zeros((h * 3 // 2, stride), np.uint8)
+        out[:h, :w] = y
+        half = [c.reshape(h // 2, 2, w // 2, 2).mean(axis=(1, 3)).round().astype(np.uint8) for c in (u, v)]
+        out[h:, :w] = np.stack(half, axis=2).reshape(h // 2, w)
+        return out
+    if fmt == "YUYV":
+        pixels = np.stack([y[:, 0::2], u[:, 0::2], y[:, 1::2], v[:, 0::2]], axis=2).reshape(h, 2 * w)
+    elif fmt == "RGB161616":  # [B, G, R] words as RGB888's bytes, little-endian, full 16-bit scale
+        pixels = (rgb[..., ::-1].astype("<u2") * 257).reshape(h, -1).view(np.uint8)
+    elif fmt == "XBGR8888":  # [R, G, B, X] bytes
+        pixels = np.concatenate([rgb, np.full((h, w, 1), 255, np.uint8)], axis=2).reshape(h, -1)
+    else:  # RGB888: [B, G, R] bytes
+        pixels = rgb[..., ::-1].reshape(h, -1)
+    flat = np.zeros((h, stride), np.uint8)
+    flat[:, : pixels.shape[1]] = pixels
+    return flat
+
+
 class Job:
     """What a false ``wait`` returns (job.py): ``get_result(timeout)``."""
 
@@ -115,16 +173,10 @@ class CompletedRequest:
         self.ref_count = 1
         self.sequence = sequence
         self.buffers: Dict[str, np.ndarray] = {}
-        rgb = SCENE(sequence, *reversed(cam.asked_main))
         main = cam.camera_config["main"]
         w, h = main["size"]
-        if main["format"] == "XBGR8888":
-            pixels = np.concatenate([rgb, np.full((*rgb.shape[:2], 1), 255, np.uint8)], axis=2)
-        else:  # RGB888: [B, G, R] bytes
-            pixels = rgb[..., ::-1]
-        flat = np.zeros((h, main["stride"]), np.uint8)
-        flat[:, : pixels.shape[1] * pixels.shape[2]] = pixels.reshape(h, -1)
-        self.buffers["main"] = flat
+        rgb = np.ascontiguousarray(SCENE(sequence, *reversed(cam.asked_main))[:h, :w])
+        self.buffers["main"] = _main_buffer(rgb, main["format"], main["stride"])
         lores = cam.camera_config.get("lores")
         if lores is not None:
             lw, lh = lores["size"]
@@ -144,9 +196,21 @@ class CompletedRequest:
             return buf[:, : w * 3].reshape(h, w, 3)
         if fmt == "XBGR8888":
             return buf[:, : w * 4].reshape(h, w, 4)
+        if fmt == "RGB161616":
+            return buf[:, : w * 6].view(np.uint16).reshape(h, w, 3)
+        if fmt == "YUYV":
+            return buf.reshape(h, buf.shape[1] // 2, 2)
+        if fmt == "MJPEG":
+            if "mjpeg_bytes" in QUIRKS:
+                return buf
+            return cv2.imdecode(buf, cv2.IMREAD_COLOR)[..., ::-1]  # PIL's R, G, B
+        if fmt == "NV12":
+            raise RuntimeError("Format NV12 not supported")
         return buf  # YUV420: (H·3/2, stride), padding kept
 
     def make_buffer(self, name: str) -> np.ndarray:
+        if "make_buffer_fails" in QUIRKS:
+            raise RuntimeError("failed to find buffer")
         return self.buffers[name].reshape(-1).copy()
 
     def make_array(self, name: str) -> np.ndarray:
@@ -215,6 +279,15 @@ class Picamera2:
         self.asked_main = (640, 480)
         INSTANCES.append(self)
 
+    def __getattribute__(self, name: str) -> Any:
+        gone = {"config_attr_only": ("camera_configuration", "stream_configuration"),
+                "preview_only": ("create_video_configuration",),
+                "no_create": ("create_video_configuration", "create_preview_configuration",
+                              "create_still_configuration")}
+        if any(name in names for quirk, names in gone.items() if quirk in QUIRKS):
+            raise AttributeError(name)  # hasattr() says False, as for a picamera2 without the method
+        return object.__getattribute__(self, name)
+
     @staticmethod
     def global_camera_info() -> List[Dict[str, Any]]:
         return [{"Model": "imx219", "Location": 2, "Rotation": 0, "Id": "/base/imx219@10", "Num": 0}]
@@ -231,20 +304,30 @@ class Picamera2:
                 "lores": None if lores is None else dict(lores), "raw": None,
                 "controls": dict(controls or {}), "sensor": {}, "display": "main", "encode": "main"}
 
+    def create_preview_configuration(self, main: Optional[dict] = None, lores: Optional[dict] = None,
+                                     **kw: Any) -> dict:
+        video = object.__getattribute__(self, "create_video_configuration")  # there even with preview_only
+        return {**video(main or {"format": "XBGR8888", "size": (640, 480)}, lores, **kw), "use_case": "preview"}
+
+    create_still_configuration = create_preview_configuration
+
     def configure(self, config: Any = None) -> None:
         if self.started:
             raise RuntimeError("Camera must be stopped before configuring")
-        config = dict(config)
+        config = copy.deepcopy(config) if "config_attr_only" in QUIRKS else dict(config)
         main = config["main"]
         w, h = (int(v) for v in main["size"])
         self.asked_main = (w, h)
-        fmt = "XBGR8888" if "xbgr" in QUIRKS else main["format"]
-        bpp = 4 if fmt == "XBGR8888" else 3
-        main.update(format=fmt, size=(w, h), stride=((w * bpp + 63) // 64) * 64)
-        main["framesize"] = main["stride"] * h
+        fmt = next((f for q, f in MAIN_GRANTS.items() if q in QUIRKS), main["format"])
+        if "aligned" in QUIRKS:
+            w, h = w - w % ALIGN.get(fmt, 32), h - h % 2
+        main.update(format=fmt, size=(w, h), stride=((w * BYTES_PER_PX[fmt] + 63) // 64) * 64)
+        main["framesize"] = main["stride"] * h * 3 // 2 if fmt in ("YUV420", "NV12") else main["stride"] * h
         lores = config.get("lores")
         if lores is not None:
             lw, lh = (int(v) for v in lores["size"])
+            if "aligned" in QUIRKS:
+                lw, lh = lw - lw % 64, lh - lh % 2
             if "lores_smaller" in QUIRKS:
                 lw, lh = lw // 2, lh // 2
             stride = lw if "lores_unpadded" in QUIRKS else ((lw + 63) // 64) * 64
