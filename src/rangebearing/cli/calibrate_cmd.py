@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import logging
 import math
 import sys
@@ -12,7 +13,7 @@ from typing import Any
 from ..config import Config
 from ..core.fit import Fit
 from ..core.focal_check import FocalCheck
-from ..errors import CalibrationError, RangeBearingError
+from ..errors import CalibrationError, OutputError, RangeBearingError
 from ..evaluation.calibrate import calibrate_checked
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import (
@@ -25,7 +26,7 @@ from .common import (
     quiet_or_auto,
     save_config,
 )
-from .outputs import check_output_file
+from .outputs import check_output_file, write_bytes_atomic
 
 STRICT_EXIT = 3  # the config is written, but the bearings say the intrinsics are wrong
 
@@ -100,8 +101,15 @@ def plot_fit(fit: Fit, path: str) -> None:
     b.axhline(0, color="k", lw=1)
     b.set(xlabel="true range (m)", ylabel="range residual (%)", title="residuals")
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    image = io.BytesIO()
+    fig.savefig(image, dpi=100, format=_plot_format(path))
     plt.close(fig)
+    write_bytes_atomic(path, image.getvalue())  # a full disk: OutputError naming it, no half-written plot
+
+
+def _plot_format(path: str) -> str:
+    """The image format a --plot path asks for by its suffix (png without one)."""
+    return Path(path).suffix[1:].lower() or "png"
 
 
 def report_focal(check: FocalCheck, refitted: bool, cfg: Config) -> None:
@@ -147,9 +155,13 @@ def _check_outputs(args: argparse.Namespace) -> None:
         check_output_file(args.plot, "--plot", (*inputs, args.out), args.overwrite)
         logging.getLogger("matplotlib").setLevel(logging.ERROR)  # no font-cache chatter in the output
         try:
-            import matplotlib  # noqa: F401
+            from matplotlib.backend_bases import FigureCanvasBase
         except ImportError:
             raise RangeBearingError("--plot needs matplotlib: pip install 'rangebearing[plot]'") from None
+        formats = FigureCanvasBase.get_supported_filetypes()
+        if _plot_format(args.plot) not in formats:
+            raise OutputError(f"--plot: matplotlib cannot write {args.plot} (.{_plot_format(args.plot)}); "
+                              f"name it .png or one of {', '.join(sorted(formats))}")
 
 
 def run(args: argparse.Namespace) -> int:

@@ -9,6 +9,7 @@ leaves the old file or the new one, never half of one.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from pathlib import Path
@@ -50,8 +51,16 @@ def check_output_file(path: PathLike, flag: str, inputs: Iterable[Optional[PathL
     if not out.parent.is_dir():
         raise OutputError(f"{flag}: cannot write {path}: No such file or directory ({out.parent} does not exist)")
     if not os.access(out.parent, os.W_OK):
-        raise OutputError(f"{flag}: cannot write in {out.parent} (permission denied)")
+        raise OutputError(f"{flag}: cannot write in {out.parent} ({_why_not_writable(out.parent)})")
     return out
+
+
+def _why_not_writable(folder: Path) -> str:
+    try:
+        read_only = bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):  # no statvfs (Windows): say what access() said
+        read_only = False
+    return "a read-only file system" if read_only else "permission denied"
 
 
 def check_output_dir(path: PathLike, flag: str, inputs: Iterable[Optional[PathLike]], overwrite: bool,
@@ -107,14 +116,29 @@ class AtomicText:
         self.file = os.fdopen(fd, "w", encoding="utf-8")
 
     def write(self, text: str) -> None:
-        self.file.write(text)
+        """Append ``text``; OutputError (the temporary file dropped) if it cannot be written (a full disk)."""
+        try:
+            self.file.write(text)
+        except OSError as exc:
+            self._fail(exc)
 
     def close(self, keep: bool = True) -> None:
-        """Rename into place (``keep``), or drop the temporary file."""
+        """Rename into place (``keep``), or drop the temporary file; OutputError if the text cannot be kept."""
         if self.file.closed:
             return
-        self.file.close()
-        if keep:
-            os.replace(self._tmp, self.path)
-        else:
+        try:
+            self.file.close()
+            if keep:
+                os.replace(self._tmp, self.path)
+                return
+        except OSError as exc:
+            self._fail(exc)
+        with contextlib.suppress(OSError):
             os.unlink(self._tmp)
+
+    def _fail(self, exc: OSError) -> None:
+        with contextlib.suppress(OSError):
+            self.file.close()  # the buffered rest may fail again: the file is dropped anyway
+        with contextlib.suppress(OSError):
+            os.unlink(self._tmp)
+        raise OutputError(f"cannot write {self.path}: {exc.strerror or exc}") from None

@@ -20,6 +20,7 @@ from ..errors import CalibrationError, FrameError
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
 from .common import add_config_arg, add_source_args, config_from_args, save_config, source_from_args
+from .outputs import check_output_file
 
 LATENCY_FRAMES = 6  # frames to discard after set_controls (libcamera applies controls a few frames on)
 
@@ -135,6 +136,8 @@ def run(args: argparse.Namespace) -> int:
     src_cfg = source_from_args(args, cfg.source) or cfg.source
     cfg = dataclasses.replace(cfg, source=src_cfg)
     check(cfg)
+    # fail now, not after the frames: a writable file (an existing one is kept as .bak), never the recording
+    check_output_file(args.out, "--out", (src_cfg.path if src_cfg.kind == "recorded" else "",), overwrite=True)
     source = open_source(src_cfg, cfg.camera)
     locked: Dict[str, Any] = {}
     try:
