@@ -87,8 +87,8 @@ def test_a_plot_format_matplotlib_lacks_is_refused_before_the_fit(frames: Path, 
     ["intrinsics", "{frames}", "--board", "9x6", "--square-mm", "25", "-q"],
     ["tune", "--source", "{frames}", "--loop", "--settle", "1", "--frames", "2", "--fps", "0"],
 ])
-@pytest.mark.parametrize("onto, says", [("{frames}/000000.png", "it is inside the input"),
-                                        ("{frames}", "it is the input"),
+@pytest.mark.parametrize("onto, says", [("{frames}/000000.png", "it is a frame of"),
+                                        ("{frames}", "is a folder"),
                                         ("{tmp}/missing/out.yaml", "does not exist")])
 def test_intrinsics_and_tune_refuse_an_out_they_cannot_or_must_not_write_before_the_work(
         frames: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], command: List[str], onto: str,

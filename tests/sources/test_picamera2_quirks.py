@@ -59,7 +59,7 @@ FRAME_QUIRKS = {
     "float_timestamp": True, "no_frame_duration": True, "tuple_config": True, "flush_fails": True,
     "flat_main": True, "flat_bytes": True, "yuv420_main": True, "nv12_main": True, "yuyv_main": True,
     "rgb16_main": True, "mjpeg_main": True, "mjpeg_bytes": True, "config_attr_only": True, "preview_only": True,
-    "no_create": True,
+    "no_create": True, "config_objects": True, "few_keywords": True,
 }
 # quirk -> how far a pixel may be from the scene's (a main stream through Y'CbCr or JPEG is not exact)
 TOLERANCE = {"yuv420_main": 2, "nv12_main": 2, "yuyv_main": 2, "mjpeg_main": 4, "mjpeg_bytes": 4}
@@ -156,6 +156,16 @@ def test_a_main_stream_that_does_not_fit_its_format_is_a_skipped_frame(quirky: M
     assert src.read() is not None
     src.close()
     assert not quirky.HELD
+
+
+@pytest.mark.parametrize("quirk", ["few_keywords", "no_create", "config_objects"])
+def test_the_frame_rate_reaches_a_camera_whatever_makes_its_configuration(quirky: ModuleType, quirk: str) -> None:
+    quirky.QUIRKS.add(quirk)
+    src = source(fps=50.0)
+    src.open()
+    assert quirky.INSTANCES[-1].frame_us == 20000  # FrameDurationLimits in the dict configure() was given
+    assert src.read() is not None
+    src.close()
 
 
 def test_a_size_the_camera_aligns_is_read_as_granted(quirky: ModuleType) -> None:

@@ -17,7 +17,7 @@ from ..core.intrinsics import board_points, find_corners, fit_views
 from ..errors import CalibrationError
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import add_config_arg, add_quiet_arg, config_from_args, progress, quiet_or_auto, save_config
-from .outputs import check_output_file
+from .outputs import check_config_out
 
 
 def _board(text: str) -> Tuple[int, int]:
@@ -66,7 +66,7 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     cfg = config_from_args(args)
     # fail now, not after the fit: a writable file (an existing one is kept as .bak), never one of the frames
-    check_output_file(args.out, "--out", (args.frames,), overwrite=True)
+    check_config_out(args.out, "--out", args.frames)
     cols, rows = args.board
     charuco = None
     if args.charuco:

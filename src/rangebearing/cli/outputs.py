@@ -55,6 +55,23 @@ def check_output_file(path: PathLike, flag: str, inputs: Iterable[Optional[PathL
     return out
 
 
+def check_config_out(path: PathLike, flag: str, recording: Optional[PathLike]) -> Path:
+    """``path`` as a config a command may write (an existing one is kept as ``.bak``); OutputError otherwise.
+
+    Never the recording the command reads, nor one of its frames; a new file beside the frames (as
+    ``synth`` writes camera.yaml) is fine.
+    """
+    from ..sources.recorded import IMAGE_SUFFIXES  # not on `run`'s start-up path
+
+    out = check_output_file(path, flag, (), overwrite=True)
+    if recording:
+        rec = _real(recording)
+        if out == rec or (rec in out.parents and out.suffix.lower() in IMAGE_SUFFIXES):
+            raise OutputError(f"{flag}: will not write {path}: it is {'the input' if out == rec else 'a frame of'} "
+                              f"{recording}")
+    return out
+
+
 def _why_not_writable(folder: Path) -> str:
     try:
         read_only = bool(os.statvfs(folder).f_flag & os.ST_RDONLY)

@@ -20,7 +20,7 @@ from ..errors import CalibrationError, FrameError
 from ..sources.base import FrameSource
 from ..sources.factory import open_source
 from .common import add_config_arg, add_source_args, config_from_args, save_config, source_from_args
-from .outputs import check_output_file
+from .outputs import check_config_out
 
 LATENCY_FRAMES = 6  # frames to discard after set_controls (libcamera applies controls a few frames on)
 
@@ -137,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
     cfg = dataclasses.replace(cfg, source=src_cfg)
     check(cfg)
     # fail now, not after the frames: a writable file (an existing one is kept as .bak), never the recording
-    check_output_file(args.out, "--out", (src_cfg.path if src_cfg.kind == "recorded" else "",), overwrite=True)
+    check_config_out(args.out, "--out", src_cfg.path if src_cfg.kind == "recorded" else None)
     source = open_source(src_cfg, cfg.camera)
     locked: Dict[str, Any] = {}
     try:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import importlib
 import logging
-from typing import Any, Dict
+from typing import Any, Dict, Optional
 
 from ..config import SourceConfig
 from ..errors import CameraError, CameraLibraryError
@@ -95,16 +95,42 @@ def create_configuration(cam: Any, cfg: SourceConfig, libcamera: Any) -> Dict[st
     create = _config_maker(cam, cfg.camera_num)
     if create is None:  # a stand-in with configure() only: the dict picamera2 would have made, by hand
         return {"use_case": "video", **kwargs, "raw": None, "queue": True}
-    try:
-        return create(**kwargs)
-    except TypeError:
-        if "colour_space" not in kwargs:
-            raise
-    if cfg.hflip or cfg.vflip:
-        raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need create_video_configuration(transform=)")
-    _log.warning("camera %d: create_video_configuration() takes no colour_space/transform: the camera's own",
-                 cfg.camera_num)
-    return create(**video_configuration(cfg, None))
+    while True:
+        try:
+            config = create(**kwargs)
+            break
+        except TypeError as exc:  # a keyword this picamera2 does not take: without it (main is never dropped)
+            refused = _refused_keyword(exc, kwargs)
+            if refused is None:
+                raise
+        if refused in ("colour_space", "transform"):
+            if cfg.hflip or cfg.vflip:
+                raise CameraError(f"camera {cfg.camera_num}: source.hflip/vflip need "
+                                  "create_video_configuration(transform=)")
+            _log.warning("camera %d: the configuration takes no colour_space/transform: the camera's own",
+                         cfg.camera_num)
+            kwargs = {k: v for k, v in kwargs.items() if k not in ("colour_space", "transform")}
+        else:
+            _log.warning("camera %d: the configuration takes no %s=: left out", cfg.camera_num, refused)
+            kwargs = {k: v for k, v in kwargs.items() if k != refused}
+    if "controls" not in kwargs and isinstance(config, dict):  # configure() reads them from the dict
+        config = {**config, "controls": {**(config.get("controls") or {}), **camera_controls(cfg)}}
+    return config
+
+
+_DROPPABLE = ("colour_space", "transform", "buffer_count", "controls", "lores")
+
+
+def _refused_keyword(exc: TypeError, kwargs: Dict[str, Any]) -> Optional[str]:
+    """The keyword a TypeError names ("unexpected keyword argument 'buffer_count'"), if it can go; else None.
+
+    A TypeError that names none (a stand-in's own wording) drops the libcamera extras first, if still there.
+    """
+    text = str(exc)
+    named = [k for k in _DROPPABLE if k in kwargs and f"'{k}'" in text]
+    if named:
+        return named[0]
+    return "colour_space" if "colour_space" in kwargs else None
 
 
 def _config_maker(cam: Any, camera_num: int) -> Any:
@@ -128,12 +154,13 @@ def granted_configuration(cam: Any, asked: Dict[str, Any]) -> Dict[str, Any]:
     passed to ``configure()`` (whose stream dicts the real ``configure`` fills in
     with the granted size, format and stride: it copies the outer dict only).
     """
+    asked = as_dict(asked)
     for read in (lambda: cam.camera_configuration(), lambda: cam.camera_config):  # the first returns the second
         try:
-            active = read()
+            active = as_dict(read())
         except (AttributeError, TypeError, RuntimeError, KeyError):
             continue
-        if isinstance(active, dict) and isinstance(active.get("main"), dict):
+        if isinstance(active.get("main"), dict):
             if "colour_space" not in active and "colour_space" in asked:
                 return {**active, "colour_space": asked["colour_space"]}
             return active
@@ -141,9 +168,22 @@ def granted_configuration(cam: Any, asked: Dict[str, Any]) -> Dict[str, Any]:
     try:
         for name in ("main", "lores"):
             if asked.get(name) is not None:
-                streams[name] = cam.stream_configuration(name)
-        if isinstance(streams.get("main"), dict):
+                streams[name] = as_dict(cam.stream_configuration(name))
+        if isinstance(streams.get("main"), dict) and streams["main"]:
             return {**asked, **streams}
     except (AttributeError, TypeError, RuntimeError, KeyError):
         pass
     return asked
+
+
+def as_dict(config: Any) -> Dict[str, Any]:
+    """A configuration as picamera2's dict: a dict as is, a ``CameraConfiguration`` / ``StreamConfiguration``
+    (picamera2 configuration.py) through ``make_dict()``; anything else is an empty dict.
+    """
+    if isinstance(config, dict):
+        return config
+    make_dict = getattr(config, "make_dict", None)
+    if callable(make_dict):
+        made = make_dict()
+        return made if isinstance(made, dict) else {}
+    return {}

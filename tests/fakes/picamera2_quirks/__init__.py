@@ -32,6 +32,11 @@ library documents or has done:
   attribute; ``configure()`` deep-copies what it is given (so the asked dict says nothing) and grants XBGR8888.
 - ``preview_only``: no ``create_video_configuration`` (``create_preview_configuration`` only);
   ``no_create``: no ``create_*_configuration`` at all (``configure(dict)`` only).
+- ``config_objects``: configurations are objects as in picamera2 configuration.py (``CameraConfiguration``:
+  attributes and ``make_dict()``, not subscriptable), from ``create_*`` and ``camera_configuration()``.
+- ``few_keywords``: ``create_video_configuration`` takes ``main`` and ``lores`` only (TypeError "unexpected
+  keyword argument" for the rest, as an early or a hand-written picamera2 would); ``configure()`` still
+  reads ``controls`` from the dict.
 - ``aligned``: ``configure()`` applies ``align_configuration(optimal=True)`` (VC4: widths down to 32 px,
   YUV420 64, XBGR8888 16; heights even), so the size granted is not the one asked.
 
@@ -154,6 +159,25 @@ def _main_buffer(rgb: np.ndarray, fmt: str, stride: int) -> np.ndarray:
     flat = np.zeros((h, stride), np.uint8)
     flat[:, : pixels.shape[1]] = pixels
     return flat
+
+
+class Configuration:
+    """picamera2 configuration.py's object form of a configuration dict: attributes and ``make_dict()``."""
+
+    _STREAMS = ("main", "lores", "raw", "sensor")
+
+    def __init__(self, d: Dict[str, Any]) -> None:
+        self.__dict__["_d"] = {k: Configuration(v) if k in self._STREAMS and isinstance(v, dict) else v
+                               for k, v in d.items()}
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self.__dict__["_d"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def make_dict(self) -> Dict[str, Any]:
+        return {k: v.make_dict() if isinstance(v, Configuration) else v for k, v in self.__dict__["_d"].items()}
 
 
 class Job:
@@ -292,7 +316,15 @@ class Picamera2:
     def global_camera_info() -> List[Dict[str, Any]]:
         return [{"Model": "imx219", "Location": 2, "Rotation": 0, "Id": "/base/imx219@10", "Num": 0}]
 
-    def create_video_configuration(self, main: Optional[dict] = None, lores: Optional[dict] = None,
+    def create_video_configuration(self, *args: Any, **kw: Any) -> Any:
+        if "few_keywords" in QUIRKS:
+            for key in kw:
+                if key not in ("main", "lores"):
+                    raise TypeError(f"create_video_configuration() got an unexpected keyword argument '{key}'")
+        config = self._video_configuration(*args, **kw)
+        return Configuration(config) if "config_objects" in QUIRKS else config
+
+    def _video_configuration(self, main: Optional[dict] = None, lores: Optional[dict] = None,
                                    raw: Any = None, transform: Any = None, colour_space: Any = None,
                                    buffer_count: int = 6, controls: Optional[dict] = None, **kw: Any) -> dict:
         for key in kw:
@@ -314,6 +346,8 @@ class Picamera2:
     def configure(self, config: Any = None) -> None:
         if self.started:
             raise RuntimeError("Camera must be stopped before configuring")
+        if isinstance(config, Configuration):
+            config = config.make_dict()
         config = copy.deepcopy(config) if "config_attr_only" in QUIRKS else dict(config)
         main = config["main"]
         w, h = (int(v) for v in main["size"])
@@ -341,11 +375,12 @@ class Picamera2:
             config["colour_space"] = str(config["colour_space"])
         self.camera_config = config
 
-    def camera_configuration(self) -> Dict[str, Any]:
-        return self.camera_config
+    def camera_configuration(self) -> Any:
+        return Configuration(self.camera_config) if "config_objects" in QUIRKS else self.camera_config
 
-    def stream_configuration(self, name: str = "main") -> Dict[str, Any]:
-        return self.camera_config[name]
+    def stream_configuration(self, name: str = "main") -> Any:
+        stream = self.camera_config[name]
+        return Configuration(stream) if "config_objects" in QUIRKS else stream
 
     def start(self, config: Any = None, show_preview: bool = False) -> None:
         if not self.camera_config:
