@@ -121,3 +121,13 @@ def test_run_check_loads_only_what_the_daemon_needs() -> None:
                 or m == "rangebearing.core.fit" or (m.startswith("rangebearing.cli.") and m.endswith("_cmd")
                                                     and m != "rangebearing.cli.run_cmd")]
     assert unwanted == []
+
+
+@pytest.mark.parametrize("closed", [1, 2])
+def test_a_command_started_with_stdout_or_stderr_closed_runs_to_the_end(closed: int) -> None:
+    """``rangebearing replay clip >&-`` (Python then has no sys.stdout): the frames are replayed, nothing crashes."""
+    proc = subprocess.run([sys.executable, "-m", "rangebearing.cli.main", "replay", str(CLIP)],
+                          stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=120,
+                          preexec_fn=lambda: os.close(closed))
+    assert proc.returncode == 0, (proc.stdout + proc.stderr)[-2000:]
+    assert "a bug?" not in proc.stdout + proc.stderr and "Traceback" not in proc.stdout + proc.stderr

@@ -138,6 +138,7 @@ def describe_error(exc: BaseException) -> str:
 def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
     args_list = list(sys.argv[1:] if argv is None else argv)
+    _closed_streams_to_devnull()
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")  # OpenCV's own [ WARN ] lines stay off stderr
     if chosen_command(args_list) == "run" and "numpy" not in sys.modules:
         # the daemon is one thread of work: OpenBLAS would start a spinning thread per core at numpy's import
@@ -177,6 +178,13 @@ def _run(args_list: List[str]) -> int:
             raise
         print(f"rangebearing: error: {describe_error(exc)}", file=sys.stderr, flush=True)
         return EXIT_CONFIG if isinstance(exc, ConfigError) else EXIT_ERROR
+
+
+def _closed_streams_to_devnull() -> None:
+    """Started with stdout or stderr closed (``>&-``: Python makes them None): write those to /dev/null."""
+    for name in ("stdout", "stderr"):
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))  # noqa: SIM115  (for the process's life)
 
 
 def _silence_stdout() -> None:
