@@ -131,3 +131,12 @@ def test_a_command_started_with_stdout_or_stderr_closed_runs_to_the_end(closed: 
                           preexec_fn=lambda: os.close(closed))
     assert proc.returncode == 0, (proc.stdout + proc.stderr)[-2000:]
     assert "a bug?" not in proc.stdout + proc.stderr and "Traceback" not in proc.stdout + proc.stderr
+
+
+def test_a_console_that_cannot_show_the_units_gets_them_replaced_not_an_error() -> None:
+    """An ASCII stdout (PYTHONIOENCODING=ascii, an old serial console) cannot encode "±" or "°"."""
+    proc = subprocess.run([sys.executable, "-m", "rangebearing.cli.main", "replay", str(CLIP)],
+                          stdin=subprocess.DEVNULL, capture_output=True, timeout=120,
+                          env={**os.environ, "PYTHONIOENCODING": "ascii"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert b" m ?" in proc.stdout and b"a bug?" not in proc.stderr  # "0.697 m ?0.9 mm": replaced, every frame

@@ -11,6 +11,7 @@ evaluation code or the calibration fit.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import importlib
 import logging
@@ -138,7 +139,7 @@ def describe_error(exc: BaseException) -> str:
 def main(argv: Optional[List[str]] = None) -> int:
     """Run the command line; returns the exit status."""
     args_list = list(sys.argv[1:] if argv is None else argv)
-    _closed_streams_to_devnull()
+    _safe_streams()
     os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")  # OpenCV's own [ WARN ] lines stay off stderr
     if chosen_command(args_list) == "run" and "numpy" not in sys.modules:
         # the daemon is one thread of work: OpenBLAS would start a spinning thread per core at numpy's import
@@ -180,11 +181,17 @@ def _run(args_list: List[str]) -> int:
         return EXIT_CONFIG if isinstance(exc, ConfigError) else EXIT_ERROR
 
 
-def _closed_streams_to_devnull() -> None:
-    """Started with stdout or stderr closed (``>&-``: Python makes them None): write those to /dev/null."""
+def _safe_streams() -> None:
+    """stdout and stderr that any text goes to: /dev/null for a closed one (``>&-``: Python makes it None);
+    a character the stream's encoding lacks ("±", "°" on an ASCII console) is replaced, never an error.
+    """
     for name in ("stdout", "stderr"):
-        if getattr(sys, name) is None:
+        stream = getattr(sys, name)
+        if stream is None:
             setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))  # noqa: SIM115  (for the process's life)
+        elif callable(getattr(stream, "reconfigure", None)) and getattr(stream, "errors", "") == "strict":
+            with contextlib.suppress(ValueError, OSError):  # a stream that cannot change: as it is
+                stream.reconfigure(errors="replace")
 
 
 def _silence_stdout() -> None:
