@@ -84,11 +84,53 @@ def test_a_chroma_edge_bled_3_px_into_the_body_still_takes_the_luma_edge_in_a_ta
     assert luma_inner(p, 20.3 + offset, True, 5.0) is None
 
 
+@pytest.mark.parametrize("offset", [1.0, 2.0, 3.0])
+def test_the_luma_edge_is_taken_when_coarse_coding_drew_the_chroma_edge_back_into_the_band(offset):
+    # MJPEG and video blocks move a band's chroma edge into the band as well as into the body
+    p = _luma_profile(20.3)
+    assert luma_inner(p, 20.3 - offset, True, 8.0) == pytest.approx(20.3, abs=1e-4)
+    q = p[::-1].copy()
+    assert luma_inner(q, 39 - 20.3 + offset, False, 8.0) == pytest.approx(39 - 20.3, abs=1e-4)
+
+
 def test_a_luma_edge_far_from_the_chroma_one_is_not_taken():
-    # a dark mast in front of the body, right below the band: luma steps 3 rows lower than the band ends
-    p = _luma_profile(23.3)
+    # a dark part in front of the body, below the band: luma steps 5 rows lower than the band ends,
+    # past the middle of an 8-row band either way
+    p = _luma_profile(25.3)
     assert luma_inner(p, 20.3, True, 8.0) is None
+    assert luma_inner(_luma_profile(15.3), 20.3, True, 8.0) is None
     assert luma_inner(_luma_profile(20.3, band=0.7), 20.3, True, 8.0) is None  # no luma step at all
+
+
+def _dark_below_red(rows_dark, part=0.05):
+    """:func:`_camera`'s landmark (scale 1, grey 0.3, 1.5 px colour denoise) with a dark part in front
+    of the white body's top ``rows_dark`` rows, right below the red band (a nearer robot's board)."""
+    ss, rows = 8, 120
+    y = (np.arange(rows * ss) + 0.5) / ss
+    r0 = 20.3
+    r1, b0, b1 = r0 + 15, r0 + 55, r0 + 70
+    lin = np.full((rows * ss, 3), 0.3)
+    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
+    lin[(y >= r1) & (y < b0)] = 0.85
+    lin[(y >= r1) & (y < r1 + rows_dark)] = part
+    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
+    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
+    img[:, :20] = img[:, 60:] = 0.3
+    img = cv2.GaussianBlur(img, (0, 0), 1.0)
+    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
+    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    cand = Candidate((20, 20, 40, 15), (20, 75, 40, 15), 40.0, False, False, False, False, 1.0)
+    return subsample_chroma(chroma_denoise(bgr, 1.5)), cand
+
+
+@pytest.mark.parametrize("rows_dark", [2.0, 3.0])
+def test_a_dark_part_across_the_body_below_the_red_band_is_not_taken_for_its_edge(rows_dark):
+    # its luma step lies within the inner edge's reach, but the red band would read 17-18 rows on a
+    # 37-38 row body: the proportions keep the chroma's edge
+    img, cand = _dark_below_red(rows_dark)
+    rows = measure_rows(img, cand, (1.0, 1.0, 1.0), GEOMETRY, 39.5)
+    assert not rows.red_luma and rows.red_px == pytest.approx(15.0, abs=0.6)
+    assert rows.blue_y_px - rows.red_y_px == pytest.approx(55.0, abs=0.6)
 
 
 def _sharpened(edge, band=0.1, white=0.4, n=40):

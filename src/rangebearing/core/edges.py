@@ -207,7 +207,7 @@ def _curve_basis(columns: bytes) -> Tuple[np.ndarray, np.ndarray]:
 
 LUMA_REACH_PX = 4  # rows past a band's chroma edge that its luma edge is integrated over
 LUMA_STEP = 0.25  # the luma step at an edge must reach this share of the brighter side's luma
-BLEED_PX = (-0.5, 2.0)  # how far (towards the band) a luma inner edge may lie from the chroma one
+BLEED_PX = 2.0  # how far either way a luma inner edge may lie from the chroma one, at the least
 OUTER_BLEED_PX = 2.0  # ... and a luma outer edge, either way
 LUMA_RING = 0.1  # luma beyond both levels by this share of the step beside an edge: the camera sharpens
 
@@ -222,13 +222,14 @@ def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: boo
     Luma keeps full resolution through colour denoise and 4:2:0 chroma, which bleed a band's
     colour across its edges, the more in linear light the brighter the other side: into the
     white body always (the chroma edge moves into it by up to a pixel or two: L short, range
-    2-5 % long on such a camera; 3-4 px under video coding), into a light background too. An
-    inner luma edge is taken when it lies 0-2 px from the chroma one towards the band, the way
-    that bleed moves it, or farther but short of the middle of the band as ``band_px`` (the
-    chroma's) spans it; an outer
-    one within 2 px either way, when the background's luma differs from the band's. Otherwise
-    (a mast or a nearer robot's part in front of the body, a background of the band's luma) the
-    chroma edge stands.
+    2-5 % long on such a camera; 3-4 px under video coding), into a light background too. Coarse
+    coding (MJPEG, video blocks) and lateral colour move the chroma edge the other way as well,
+    into the band. An inner luma edge is taken when it lies within 2 px of the chroma one, or
+    farther but short of the middle of the band as ``band_px`` (the chroma's) spans it, either
+    way; an outer one within 2 px either way, when the background's luma differs from the
+    band's. Otherwise (a background of the band's luma) the chroma edge stands. A luma step
+    from a shadow or a part in front of the body within that reach is left to the caller: it
+    spoils the landmark's proportions (:func:`.measure._rows`).
 
     The luma edge is the two-level integral, unless the luma beside it overshoots either level
     by more than ``LUMA_RING`` of the step: a camera's sharpening puts a bright lobe on one side
@@ -257,9 +258,9 @@ def luma_edge(p: np.ndarray, edge: float, down: bool, band_px: float, inner: boo
     if found is None:
         return None
     shift = s * (edge - found)  # towards the band
-    # an inner edge may lie anywhere the chroma bled over, short of the band's middle (video coding: 3-4 px)
-    lo, hi = (BLEED_PX[0], max(BLEED_PX[1], 0.5 * band_px - 0.5)) if inner else (-OUTER_BLEED_PX, OUTER_BLEED_PX)
-    return found if lo <= shift <= hi else None
+    # an inner edge may lie anywhere the chroma bled over or drew back from, short of the band's middle
+    reach = max(BLEED_PX, 0.5 * band_px - 0.5) if inner else OUTER_BLEED_PX
+    return found if -reach <= shift <= reach else None
 
 
 def _crossing(p: np.ndarray, a: int, z: int, half: float) -> Optional[float]:
