@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import gc
 import os
 import sys
 import tempfile
@@ -27,6 +28,7 @@ import numpy as np
 from rangebearing.config import Config, PublishConfig, SourceConfig
 from rangebearing.core.stats import percentile
 from rangebearing.daemon.loop import Daemon
+from rangebearing.daemon.process import THRESHOLDS
 from rangebearing.sources.factory import open_source
 
 
@@ -79,11 +81,16 @@ def run_once(cfg: Config, clip: Path, fps: float, seconds: float, later: bool, s
     def opener(c: Config, sleep: Any) -> Any:
         return _Stamped(open_source(c.source, c.camera, sleep=sleep, in_place=True), reads)
 
-    daemon = Daemon(run_cfg, opener, lambda c: pub, _Quiet())
+    # as `rangebearing run` builds it: start-up frozen, the collector after the send, no timer slack
+    daemon = Daemon(run_cfg, opener, lambda c: pub, _Quiet(), freeze_gc=True)
     timer = threading.Timer(seconds, daemon.stop)
     timer.start()
     c0 = time.thread_time_ns()
-    daemon.run()
+    try:
+        daemon.run()
+    finally:
+        gc.unfreeze()  # the next round starts as this one did
+        gc.set_threshold(*THRESHOLDS)
     total_ns = time.thread_time_ns() - c0
     timer.cancel()
     n = min(len(reads), len(pub.marks))

@@ -224,6 +224,34 @@ class TestRecordedSource:
         assert frame is not None and frame.index == 4 and frame.name == names[1]
         assert source.dropped == 3
 
+    def test_a_looped_frame_is_made_before_it_is_due_as_a_camera_hands_over_a_ready_buffer(
+            self, tmp_path: Path) -> None:
+        names = write_images(tmp_path, 3)
+        clock = FakeClock()
+        source = RecordedSource(tmp_path, fps=10, loop=True, clock=clock, sleep=clock.sleep, lores=True,
+                                in_place=True)
+        source.open()
+        made: List[tuple] = []
+        frame_of = source._frame
+
+        def noted(reader, fetched, i):  # when each frame was made: before or after its wait
+            made.append((i, len(clock.sleeps)))
+            return frame_of(reader, fetched, i)
+
+        source._frame = noted  # type: ignore[method-assign]
+        first_loop = [source.read() for _ in range(3)]
+        assert [m[1] for m in made] == [0, 1, 2]  # the first loop's YUV420 is made once its frame is due
+        made.clear()
+        again = [source.read() for _ in range(3)]
+        assert made == [(3, 2), (4, 3), (5, 4)]  # now made before each wait
+        assert [f.index for f in again] == [3, 4, 5] and [f.name for f in again] == names
+        assert [f.t_mono_ns for f in again] == [1_000_000_000 + i * PERIOD_NS for i in (3, 4, 5)]
+        assert all(a.lores_yuv420 is b.lores_yuv420 for a, b in zip(first_loop, again))
+        made.clear()
+        clock.advance(2.5)  # a late consumer: the frame made ahead is skipped, the newest due one is made
+        late = source.read()
+        assert late is not None and late.index == 7 and [m[0] for m in made] == [6, 7] and source.dropped == 1
+
     def test_corrupt_image_raises_then_the_next_read_continues(self, tmp_path: Path) -> None:
         names = write_images(tmp_path, 3)
         (tmp_path / names[1]).write_bytes(b"garbage")

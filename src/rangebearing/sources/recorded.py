@@ -33,8 +33,7 @@ def list_images(directory: Path) -> List[Path]:
 
 
 def _decode(path: Path) -> Optional[np.ndarray]:
-    # the raw bytes decoded (any file name; None, not an exception, for a corrupt, huge or unreadable file)
-    return decode_file(path)
+    return decode_file(path)  # any file name; None, not an exception, for a corrupt, huge or unreadable file
 
 
 def _check_path(path: PathLike) -> Path:
@@ -154,6 +153,9 @@ class _ImageDir:
         self._cache = None
 
 
+Reader = Union[_ImageDir, VideoFrames, McapFrames]
+
+
 class RecordedSource:
     """Recorded frames served like a live camera.
 
@@ -168,10 +170,9 @@ class RecordedSource:
     YUV420 stream a Pi camera delivers beside each frame (OpenCV's I420 of
     it; kept with the decoded frame when looping, as the ISP makes it for free).
     ``in_place`` (a caller done with each frame before the next, the daemon):
-    a looping clip's decoded frames are handed out read-only, uncopied.
-    A looping directory's decoded frames and their YUV420 live in the page
-    cache (:class:`~.clip_store.ClipStore`), mapped into the process only while
-    a frame is in use: the clip does not count in the daemon's memory.
+    a looping clip's decoded frames are handed out read-only, uncopied. A
+    looping directory's decoded frames and their YUV420 live in the page cache
+    (:class:`~.clip_store.ClipStore`), mapped in only while a frame is in use.
     """
 
     may_block = False  # reads wait only on ``sleep`` (a stop ends them): no reader thread needed
@@ -194,7 +195,7 @@ class RecordedSource:
         self._store = ClipStore()
         self._clock = clock
         self._pacer = Pacer(float(fps), clock, sleep) if fps else None
-        self._reader: Union[_ImageDir, VideoFrames, McapFrames, None] = None
+        self._reader: Optional[Reader] = None
         self._next = 0
         self._dropped = 0
 
@@ -231,31 +232,35 @@ class RecordedSource:
         i = self._next
         if not self._loop and reader.length is not None and i >= reader.length:
             return None  # the end: no point waiting for a frame that will never come
-        ahead = None
+        ahead, ready = None, None
         if self._pacer is not None:
-            # Decode before the frame is due, as a camera delivers frames ready to use,
-            # so capture-to-send latency measures the pipeline, not the PNG decoder.
+            # the frame made before it is due, as a camera delivers them ready: capture-to-send is the pipeline's
             ahead = self._fetch(reader, i)
+            if ahead is not None and ahead[1] is not None and (not self._lores or reader.name(ahead[0]) in self._yuv):
+                ready = self._frame(reader, ahead, i)  # not with its YUV420 still to make: a late read skips it
             last = None if self._loop or reader.length is None else reader.length - 1
             i = self._pacer.next_index(i, last)
             self._dropped += i - self._next
+        if ready is not None and i == self._next:
+            self._next = i + 1
+            return ready
         fetched = ahead if ahead is not None and i == self._next else self._fetch(reader, i)
         end = None if reader.length is None else reader.length - 1
         if fetched is None and end is not None and self._next <= end < i:
-            # A paced skip ran past the end of a video whose length was unknown:
-            # deliver its last frame, as a camera would have.
+            # a paced skip ran past the end of a video of unknown length: its last frame, as a camera would give
             self._dropped -= i - end
             i = end
             fetched = self._fetch(reader, i)
         if fetched is None:
             return None
-        pos, image = fetched
         self._next = i + 1
-        name = reader.name(pos)
-        if image is None:
-            raise FrameError(f"{name}: cannot decode image")
+        if fetched[1] is None:
+            raise FrameError(f"{reader.name(fetched[0])}: cannot decode image")
+        return self._frame(reader, fetched, i)
+
+    def _frame(self, reader: Reader, fetched: Tuple[int, Optional[np.ndarray]], i: int) -> Frame:
         t_ns = self._pacer.capture_ns(i) if self._pacer is not None else self._clock()
-        frame = Frame(image=image, t_mono_ns=t_ns, index=i, name=name)
+        frame = Frame(image=fetched[1], t_mono_ns=t_ns, index=i, name=reader.name(fetched[0]))
         return self._with_lores(frame) if self._lores else frame
 
     def _with_lores(self, frame: Frame) -> Frame:
@@ -278,9 +283,7 @@ class RecordedSource:
         self._yuv[frame.name] = yuv
         return Frame(frame.image, frame.t_mono_ns, frame.index, frame.name, yuv)
 
-    def _fetch(
-        self, reader: Union[_ImageDir, VideoFrames, McapFrames], i: int
-    ) -> Optional[Tuple[int, Optional[np.ndarray]]]:
+    def _fetch(self, reader: Reader, i: int) -> Optional[Tuple[int, Optional[np.ndarray]]]:
         for _ in range(2):  # a second try once a video's length has been learned
             length = reader.length
             if length is not None:
