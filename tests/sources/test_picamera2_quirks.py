@@ -296,3 +296,30 @@ def test_landmarks_in_a_main_stream_granted_in_another_format_are_found_where_rg
     assert len(found[""]) == len(found[quirk]) == len(truth)
     for (r0, b0), (r1, b1) in zip(sorted(found[""]), sorted(found[quirk])):
         assert abs(r1 - r0) <= 0.01 * r0 and abs(b1 - b0) <= 0.002
+
+
+def test_sensor_stamps_on_a_clock_of_their_own_keep_their_spacing_shifted_to_the_arrivals(
+        quirky: ModuleType) -> None:
+    """The quirks fake stamps frames 1 s + n frame periods "after boot": no clock of ours (a counter)."""
+    arrivals = iter(range(50_000_000_000, 60_000_000_000, 40_000_000))  # a frame arrives every 40 ms
+    src = Picamera2Source(SourceConfig(timeout_s=0.05, retries=3), in_place=True, stop_timeout_s=5.0,
+                          clock=lambda: next(arrivals))
+    src.open()
+    stamps = [src.read().t_mono_ns for _ in range(4)]  # type: ignore[union-attr]
+    src.close()
+    assert stamps[0] == 50_000_000_000  # the first is stamped when it arrived, not 1 s after boot
+    assert [b - a for a, b in zip(stamps, stamps[1:])] == [33_333_000] * 3  # the camera's own spacing kept
+    assert src.dropped == 0
+
+
+def test_sensor_stamps_on_no_clock_of_ours_never_lie_after_the_arrival_and_follow_a_jump() -> None:
+    from rangebearing.sources.sensor_time import SensorClock
+
+    clock = SensorClock(boot_offset_ns=0)
+    assert clock.to_monotonic_ns(9_000_000_000, 10_000_000_000) == 9_000_000_000  # monotonic: as it is
+    assert clock.to_monotonic_ns(100, 20_000_000_000) == 20_000_000_000  # a counter: shifted to its arrival
+    assert clock.to_monotonic_ns(100 + 33_000_000, 20_040_000_000) == 20_033_000_000  # its spacing kept
+    assert clock.to_monotonic_ns(100 + 66_000_000, 20_050_000_000) == 20_050_000_000  # never after arrival
+    hour = 3_600_000_000_000
+    assert clock.to_monotonic_ns(hour, 20_100_000_000) == 20_100_000_000  # a jump: the shift learnt again
+    assert clock.to_monotonic_ns(hour + 33_000_000, 20_140_000_000) == 20_133_000_000

@@ -56,7 +56,7 @@ from .camera_setup import (
     import_module,
     optional_module,
 )
-from .sensor_time import boot_offset_ns, frames_missed, sensor_to_monotonic_ns
+from .sensor_time import SensorClock, boot_offset_ns, frames_missed, sensor_to_monotonic_ns
 
 __all__ = ["Picamera2Source", "camera_controls", "frames_missed", "sensor_to_monotonic_ns"]
 from .faults import TimeoutBudget
@@ -101,7 +101,7 @@ class Picamera2Source:
         self._mapped: Any = None  # picamera2.MappedArray, or None (very old picamera2: make_array copies)
         self._held: Optional[Held] = None  # the request of the frame last returned, with its mapped streams
         self._layout: Optional[Layout] = None
-        self._boot_offset_ns = 0
+        self._sensor_clock = SensorClock(0)
         self._prev_sensor_ns: Optional[int] = None
         self._next_index = 0
         self._dropped = 0
@@ -152,7 +152,7 @@ class Picamera2Source:
             msg = f"camera {cfg.camera_num}: cannot configure and start: {exc}"
             raise CameraError(msg) from exc
         self._cam = cam
-        self._boot_offset_ns = boot_offset_ns()
+        self._sensor_clock = SensorClock(boot_offset_ns())  # a new shift too: the camera may restart its clock
         self._prev_sensor_ns = None
         self._next_index = 0
         self._dropped = 0
@@ -260,7 +260,7 @@ class Picamera2Source:
         if sensor_ns is None:
             t_ns = received_ns
         else:
-            t_ns = sensor_to_monotonic_ns(sensor_ns, received_ns, self._boot_offset_ns)
+            t_ns = self._sensor_clock.to_monotonic_ns(sensor_ns, received_ns)
             fps = self._cfg.fps
             period_ns = duration_us * 1e3 if duration_us else (1e9 / fps if fps > 0 else 0.0)
             missed = frames_missed(self._prev_sensor_ns, sensor_ns, period_ns)

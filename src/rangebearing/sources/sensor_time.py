@@ -23,6 +23,34 @@ def sensor_to_monotonic_ns(sensor_ns: int, received_ns: int, boot_offset_ns: int
     return converted if converted <= received_ns else received_ns
 
 
+MAX_LAG_NS = 5_000_000_000  # a stamp this much older than its frame's arrival is on no clock of ours
+
+
+class SensorClock:
+    """``SensorTimestamp`` put on CLOCK_MONOTONIC, also when it is on no clock we know.
+
+    A stamp on CLOCK_MONOTONIC (or BOOTTIME) lies at most :data:`MAX_LAG_NS`
+    before its frame arrived. Anything else (a stand-in counting from 0, a
+    clock of its own) keeps its spacing, which the rate filters and the drop
+    count use, shifted so that the first such frame is stamped when it
+    arrived; the shift is learnt again when the stamps jump away from the
+    arrivals, and no frame is ever stamped after it arrived.
+    """
+
+    def __init__(self, boot_offset_ns: int) -> None:
+        self.boot_offset_ns = boot_offset_ns
+        self._shift_ns: Optional[int] = None
+
+    def to_monotonic_ns(self, sensor_ns: int, received_ns: int) -> int:
+        for t in (sensor_ns, sensor_ns - self.boot_offset_ns):  # MONOTONIC (the Pi's), else BOOTTIME
+            if received_ns - MAX_LAG_NS <= t <= received_ns:
+                return t
+        shift = self._shift_ns
+        if shift is None or abs(sensor_ns + shift - received_ns) > MAX_LAG_NS:
+            shift = self._shift_ns = received_ns - sensor_ns
+        return min(sensor_ns + shift, received_ns)
+
+
 def frames_missed(prev_ns: Optional[int], sensor_ns: int, period_ns: float) -> int:
     """Frames lost between two sensor timestamps ``period_ns`` apart (0 for the first)."""
     if prev_ns is None or period_ns <= 0:
