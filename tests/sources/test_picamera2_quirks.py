@@ -246,7 +246,11 @@ def test_sensor_fields_take_only_numbers(meta: dict, want: tuple) -> None:
     assert sensor_fields(meta) == want
 
 
-def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path) -> None:
+@pytest.mark.parametrize("quirks", [
+    "no_wait,no_metadata,release_fails,flush_fails,xbgr,lores_unpadded,close_fails",
+    "yuv420_main,config_objects,few_keywords,float_timestamp",  # the main stream converted, stamps of its own
+])
+def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path, quirks: str) -> None:
     from rangebearing.net.client import Subscriber
     from rangebearing.synth import render
     from tests.conftest import STATIC_SCENE
@@ -258,7 +262,7 @@ def test_the_daemon_runs_on_the_quirkiest_camera(tmp_path: Path) -> None:
     (site / "__init__.py").write_text(f"exec(compile(open({str(QUIRKS_DIR / '__init__.py')!r}).read(), "
                                       f"{str(QUIRKS_DIR / '__init__.py')!r}, 'exec'))\n")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path / "site"), os.environ.get("PYTHONPATH", "")]),
-           "PICAMERA2_QUIRKS": "no_wait,no_metadata,release_fails,flush_fails,xbgr,lores_unpadded,close_fails",
+           "PICAMERA2_QUIRKS": quirks,
            "PICAMERA2_SCENE": str(tmp_path / "scene.npy")}
     with Subscriber(port=0, timeout_s=TIMEOUT_S) as sub:
         proc = start(tmp_path, f"""
@@ -268,7 +272,8 @@ publish: {{robot_id: pi, unicast: ["127.0.0.1:{sub.port}"]}}
         code, stderr = three_true_readings_then_stop(proc, sub)
     assert code == 0, stderr
     assert "Traceback" not in stderr, stderr
-    assert 1 <= stderr.count("release failed") <= 2, stderr  # once a camera opened (a reopen may say it again)
+    if "release_fails" in quirks:
+        assert 1 <= stderr.count("release failed") <= 2, stderr  # once a camera opened (a reopen may say it again)
 
 
 @pytest.mark.parametrize("quirk", ["yuv420_main", "yuyv_main", "rgb16_main", "mjpeg_main"])
