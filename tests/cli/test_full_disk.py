@@ -100,3 +100,14 @@ def test_intrinsics_and_tune_refuse_an_out_they_cannot_or_must_not_write_before_
     assert len(error_lines(err)) == 1 and says in error_lines(err)[0] and "--out" in error_lines(err)[0], err
     assert "board" not in out and "thresholds" not in out  # refused before any frame was read
     assert (frames / "000000.png").read_bytes() == before and not (frames / "000000.png.bak").exists()
+
+
+@pytest.mark.parametrize("command", [["run", "--fps", "0", "--record"], ["record", "--frames", "2", "--out"]])
+def test_a_recording_that_cannot_even_start_on_a_full_disk_is_one_error_and_no_empty_file(
+        frames: Path, tmp_path: Path, command: List[str]) -> None:
+    out = tmp_path / "rec.mcap"
+    status, err = rangebearing_limited(0, tmp_path.parent / "mpl", command[0], "--source", str(frames),
+                                       *command[1:], str(out), *(["-q"] if command[0] == "record" else []))
+    assert status == 1
+    assert len(error_lines(err)) == 1 and str(out) in error_lines(err)[0] and "File too large" in err, err
+    assert not out.exists()

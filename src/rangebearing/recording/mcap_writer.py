@@ -137,6 +137,8 @@ class McapRecorder:
                 self._channels[topic] = self._writer.register_channel(topic, "json", schema_id)
         except OSError as exc:
             self._abandon()
+            with contextlib.suppress(OSError):  # ours ("wb"), and not even a header in it: not left behind
+                os.unlink(self.path)
             raise RecordingError(f"{self.path}: cannot write: {exc.strerror or exc}") from None
 
     @property
