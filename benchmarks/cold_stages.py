@@ -12,8 +12,10 @@ calls, wrapped to add its thread CPU time (a wrapper costs well under a microsec
 unlike cProfile, small calls are not inflated). Stages nest as the code does: the
 structure search ``detect.search`` runs inside ``pipeline.balanced_search``, the
 band moments and rows inside ``pipeline.refine``, tracked frames' work inside
-``pipeline.step``. Printed: the median frame, then each stage's mean per frame,
-full scans and tracked frames apart.
+``pipeline.step``; ``refine.band_weights``/``tile_centroids`` inside every
+``measure_bands``, ``measure.excess_luma``/``_rows`` (one per landmark) inside every
+``measure_rows_all``, ``pipeline.white_clipped`` inside each reading. Printed: the
+median frame, then each stage's mean per frame, full scans and tracked frames apart.
 """
 
 from __future__ import annotations
@@ -47,6 +49,8 @@ STAGES = [
     ("pipeline", "verified"), ("pipeline", "drop_stacked"), ("pipeline", "chroma_blur_all"),
     ("pipeline", "step"), ("tracking", "measure_bands"), ("tracking", "measure_rows_all"), ("tracking", "combine"),
     ("pipeline", "side_view"), ("pipeline", "update"), ("pipeline", "reading"), ("pipeline", "reading_sigma"),
+    ("pipeline", "white_clipped"), ("pipeline", "crossing"),
+    ("refine", "band_weights"), ("refine", "tile_centroids"), ("measure", "excess_luma"), ("measure", "_rows"),
 ]
 
 
