@@ -14,7 +14,7 @@ to ``-s<seed>``, seeds pooled) it prints:
 * each term's mean share of the reading's σ² (the term's constant set to 0, the rest kept): range
   ``noise`` (NOISE_SHARE), ``spread`` (SPREAD_SHARE: the row estimators' disagreement, merged bands
   included), ``fit`` (FIT_SPREAD: of the bands placed from their edges alone), ``merged`` (MERGED_PX),
-  ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
+  ``blur`` (CHROMA_SHARE), ``hidden`` (HIDDEN_SHARE_L, CUT_HIDDEN_SHARE_L), ``cut`` (CUT/SPLIT_SHARE_L),
   ``floor`` (EDGE_FLOOR_PX, MODEL_FLOOR); bearing ``column``, ``spread``, ``shading``, ``hidden``,
   ``cut``, ``floor``.
 
@@ -46,10 +46,11 @@ from rangebearing.sources.recorded import iter_recorded
 
 RANGE_TERMS = {"noise": ("NOISE_SHARE",), "spread": ("SPREAD_SHARE",), "fit": ("FIT_SPREAD",), "moment": ("MOMENT_PX",),
                "merged": ("MERGED_PX",), "blur": ("CHROMA_SHARE",),
-               "hidden": ("HIDDEN_SHARE_L",), "cut": ("CUT_SHARE_L", "SPLIT_SHARE_L"),
+               "hidden": ("HIDDEN_SHARE_L", "CUT_HIDDEN_SHARE_L"), "cut": ("CUT_SHARE_L", "SPLIT_SHARE_L"),
                "floor": ("EDGE_FLOOR_PX", "MODEL_FLOOR")}
 BEARING_TERMS = {"column": ("COLUMN_SHARE",), "spread": ("SPREAD_X_SHARE",), "shading": ("SHADING_SHARE",),
-                 "hidden": ("HIDDEN_SHARE",), "cut": ("CUT_SHARE", "SPLIT_SHARE"), "floor": ("BEARING_FLOOR_RAD",)}
+                 "hidden": ("HIDDEN_SHARE", "CUT_HIDDEN_SHARE"), "cut": ("CUT_SHARE", "SPLIT_SHARE"),
+                 "floor": ("BEARING_FLOOR_RAD",)}
 
 
 SPREAD_ARG = 9  # reading_sigma's positional spread_l_px, as the pipeline passes it

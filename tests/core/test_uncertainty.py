@@ -76,6 +76,22 @@ def test_range_sigma_follows_the_spacing_error_through_the_model():
     assert u.range_sigma_m(0.5, 0.014, 100.0, 0.0, 1.0) >= u.MODEL_FLOOR * 0.5
 
 
+def test_a_cut_landmarks_hidden_share_counts_for_what_its_placement_leaves():
+    """Range: a cut landmark's rows are scaled for the part of its curve seen (core/arc.py), so its hidden
+    share costs less than an uncut one's. Bearing: it is placed from one limb, which the hidden part may be."""
+    cut = (True, False)
+    cut_whole = u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 1.0, cut=cut)
+    uncut_hidden = u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 0.6)
+    cut_hidden = u.range_sigma_m(1.0, 0.014, 30.0, 0.5, 0.6, cut=cut)
+    assert cut_whole < cut_hidden < uncut_hidden
+    b_cut = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, cut=cut)
+    b_uncut_hidden = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, visible=0.6)
+    b_cut_hidden = u.bearing_sigma_rad(0.2, 0.15, 30.0, 634.0, visible=0.6, cut=cut)
+    assert b_cut_hidden > max(b_cut, b_uncut_hidden)
+    # a merged band (placed from its inner edge) costs MERGED_PX: more than an edge's noise, less than a pixel
+    assert 0.1 < u.MERGED_PX < 1.0
+
+
 def test_white_clipped_is_the_share_of_the_body_between_the_bands_at_full_scale():
     img = np.full((100, 60, 3), 120, np.uint8)
     img[20:30, 20:40] = (40, 40, 200)  # red band rows 20-29, centre 24.5

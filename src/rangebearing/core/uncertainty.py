@@ -22,24 +22,22 @@ combines what this very frame shows about its own measurement:
   edges' width in colour beyond their width in luma measures it;
 * a band whose outer edge merged with a same-coloured background is placed
   from its inner edge and the white body's height: ``MERGED_PX``;
-* a partly hidden landmark's edges are seen over a part of the curve:
-  ``HIDDEN_SHARE_L`` of L per unit of hidden share; a landmark cut on one side
-  or both (a neighbour, the frame's edge): ``CUT_SHARE_L``/``SPLIT_SHARE_L`` of L;
+* a partly hidden landmark's edges are seen over a part of the curve: ``HIDDEN_SHARE_L`` of L per unit
+  of hidden share (``CUT_HIDDEN_SHARE_L`` if cut: :mod:`.arc` scales its rows for the part seen); a landmark
+  cut on one side or both (a neighbour, the frame's edge): ``CUT_SHARE_L``/``SPLIT_SHARE_L`` of L;
 * an over-exposed white body (clipped at full scale) swallows the mixed pixels of the
   bands' inner edges, by up to a pixel and the blur, so both bands read short towards the
   body and L long; nothing else in the frame shows it (clipping even hides the noise):
   ``CLIPPED_PX`` per band centre times the clipped share of the body (:func:`white_clipped`);
-* a floor: ``EDGE_FLOOR_PX`` per band, and the model's own error after
-  calibration (``MODEL_FLOOR``, relative).
+* a floor: ``EDGE_FLOOR_PX`` per band, and the model's own error after calibration (``MODEL_FLOOR``, relative).
 
-Bearing. ``θ = atan(−x_n)``, so ``σ_θ = cos²θ · σ_x / f``. ``σ_x`` combines the
-column measurement's own error (moments of a whole landmark, or a limb plus
-half a silhouette), the disagreement of the red and the blue band's columns
-(``|x_red − x_blue|/2``, the same two-estimator argument: a neighbour's band
-beside one of them, a shadow across one, shows there), shading across the
-cylinder (``SHADING_SHARE`` of the silhouette width), a hidden-share term, a
-landmark cut on one side (placed from its other limb: ``CUT_SHARE`` of its
-width) or both (split from touching neighbours: ``SPLIT_SHARE``) and a floor
+Bearing. ``θ = atan(−x_n)``, so ``σ_θ = cos²θ · σ_x / f``. ``σ_x`` combines the column measurement's own
+error (moments of a whole landmark, or a limb plus half a silhouette), the disagreement of the red and the
+blue band's columns (``|x_red − x_blue|/2``, the same two-estimator argument: a neighbour's band beside one
+of them, a shadow across one, shows there), shading across the
+cylinder (``SHADING_SHARE`` of the silhouette width), a hidden-share term (``CUT_HIDDEN_SHARE`` if cut:
+the hidden part may be the limb it is placed from), a landmark cut on one side (placed from its other limb:
+``CUT_SHARE`` of its width) or both (split from touching neighbours: ``SPLIT_SHARE``) and a floor
 for the outline correction and the undistortion (``BEARING_FLOOR_RAD``).
 
 The shares are set so that |error| ≤ 2σ holds for 90–98 % of the readings on
@@ -69,18 +67,20 @@ EDGE_FLOOR_PX = 0.01  # per band centre, full-resolution pixels: sampling, the o
 CHROMA_SHARE = 0.14  # per band centre, share of the colour's own blur (chroma_blur_px)
 CLIPPED_PX = 0.2  # per band centre, a wholly clipped white body's pull on the inner edges
 CLIP_LEVEL = 248  # an 8-bit channel this bright is clipped (JPEG rings a clipped area a few levels down)
-MERGED_PX = 1.42  # a band placed from its inner edge and the white height (heights on a curved surface)
-HIDDEN_SHARE_L = 0.138  # share of L per unit of hidden share (the edges' curve over the visible part)
-SPLIT_SHARE_L = 0.00596  # share of L: a landmark cut on both sides (split between neighbours)
-CUT_SHARE_L = 0.00286  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
+MERGED_PX = 0.55  # a band placed from its inner edge and the white height (heights on a curved surface)
+HIDDEN_SHARE_L = 0.164  # share of L per unit of hidden share (the edges' curve over the visible part)
+CUT_HIDDEN_SHARE_L = 0.027  # the same of a cut landmark, whose rows arc.py scales for the part seen
+SPLIT_SHARE_L = 0.00231  # share of L: a landmark cut on both sides (split between neighbours)
+CUT_SHARE_L = 0.00472  # share of L: a landmark cut on one side (a neighbour or the frame's edge)
 MODEL_FLOOR = 0.0002  # relative range error left after calibration
 # bearing: terms of the column's error (px)
 COLUMN_SHARE = 1.21  # of the column measurement's own error (moments, or a limb and half a silhouette)
 SPREAD_X_SHARE = 2.58  # of half the red and blue bands' column difference
 SHADING_SHARE = 0.00255  # column bias from shading across the cylinder, share of the silhouette width
-HIDDEN_SHARE = 0.252  # column error per unit of hidden share, in silhouette widths (the visible part's centre)
-SPLIT_SHARE = 0.0303  # column error of a landmark cut on both sides (split between neighbours), share of its width
-CUT_SHARE = 0.079  # column error of a landmark cut on one side (placed from its other limb), share of its width
+HIDDEN_SHARE = 0.289  # column error per unit of hidden share, in silhouette widths (the visible part's centre)
+CUT_HIDDEN_SHARE = 0.72  # the same of a cut landmark (placed from a limb: the hidden part may be that limb's)
+SPLIT_SHARE = 0.016  # column error of a landmark cut on both sides (split between neighbours), share of its width
+CUT_SHARE = 0.034  # column error of a landmark cut on one side (placed from its other limb), share of its width
 BEARING_FLOOR_RAD = 5e-5  # 0.003°: the outline correction and the undistortion
 EDGE_WINDOW_PX = 5  # rows searched each side of a band's expected inner edge for its steepest step
 EDGE_HALF_PX = 3  # rows each side of that step whose derivative makes the edge's width
@@ -262,7 +262,7 @@ def range_sigma_m(
     neighbour or the frame's edge on its left, right side, ``clipped`` the white body's clipped
     share (:func:`white_clipped`).
     """
-    hidden = HIDDEN_SHARE_L * (1.0 - min(1.0, visible)) * l_px
+    hidden = (CUT_HIDDEN_SHARE_L if any(cut) else HIDDEN_SHARE_L) * (1.0 - min(1.0, visible)) * l_px
     split = (SPLIT_SHARE_L if all(cut) else CUT_SHARE_L if any(cut) else 0.0) * l_px
     s_l = math.sqrt((NOISE_SHARE * sigma_l_px) ** 2 + (SPREAD_SHARE * spread_l_px) ** 2
                     + 2 * (EDGE_FLOOR_PX**2 + (CHROMA_SHARE * chroma_blur_px) ** 2 + (CLIPPED_PX * clipped) ** 2)
@@ -280,7 +280,7 @@ def bearing_sigma_rad(
     ``spread_x_px`` is half the difference of the red and blue bands' columns;
     ``cut``: the landmark ends at a neighbour or the frame's edge on its left, right side.
     """
-    hidden = HIDDEN_SHARE * (1.0 - min(1.0, visible)) * width_px / max(visible, 0.3)
+    hidden = (CUT_HIDDEN_SHARE if any(cut) else HIDDEN_SHARE) * (1.0 - min(1.0, visible)) * width_px / max(visible, 0.3)
     split = (SPLIT_SHARE if all(cut) else CUT_SHARE if any(cut) else 0.0) * width_px
     s_x = math.sqrt((COLUMN_SHARE * sigma_x_px) ** 2 + (SPREAD_X_SHARE * spread_x_px) ** 2
                     + (SHADING_SHARE * width_px) ** 2 + hidden**2 + split**2)
