@@ -69,8 +69,9 @@ SETS: Tuple[Tuple[str, str, int, bool], ...] = (
     ("photoreal-crowd", "png", 1, False),
     ("rooms", "png", 1, False),  # lighting frames in an all-red or all-blue room (appended: earlier seeds unchanged)
     ("photoreal-alt", "png", 1, False),  # photoreal scenes through another camera and paint (appended, as rooms)
+    ("mimic", "png", 1, False),  # not in the default --sets: red/white/blue things that are no landmark (false only)
 )
-DEFAULT_SETS = tuple(s[0] for s in SETS if not s[0].startswith("photoreal"))
+DEFAULT_SETS = tuple(s[0] for s in SETS if not s[0].startswith("photoreal") and s[0] != "mimic")
 # issue 8: found share of findable landmarks; paper/wide/clutter/multi keep the core issue's bounds
 MIN_FOUND = {"occlusion": 97.0, "touching": 97.0, "crowd": 97.0, "far": 99.0, "lighting": 97.0,
              "paper": 100.0, "wide": 97.0, "clutter": 100.0, "multi": 97.0,

@@ -45,7 +45,9 @@ class Recorder:
 
     def verified(self, bgr, found, geometry, model=None, cam=None):  # the pipeline calls it so
         self.stage["refined"] = list(found)
-        self.stage["reasons"] = [verify.rejection(bgr, c, geometry, model, cam, found) for c in found]
+        judge = getattr(verify, "verdicts", None)  # older checkouts (PYTHONPATH): each against all the others
+        self.stage["reasons"] = (judge(bgr, found, geometry, model, cam) if judge is not None else
+                                 [verify.rejection(bgr, c, geometry, model, cam, found) for c in found])
         return self._verified(bgr, found, geometry, model, cam)
 
     def drop_stacked(self, found):

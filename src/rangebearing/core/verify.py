@@ -37,22 +37,13 @@ the checks here ask for:
   body (a neighbour's mast or camera in front of it darkens only part) and the
   upper quartile of each band's core.
 
-- **An object, not stripes.** A white skirting board between an orange wall and
-  a blue mat reads red → white → blue in every column along the wall; where
-  something in front of the mat ends the blue for a while, the structure finds
-  a "landmark" there. A landmark is an object: beside it, at the rows of its red
-  band and of its white body, lies something else (a background, a wall), not
-  both of its own colours again, lined up with its red band's and its body's
-  own rows. A candidate whose band and body colours both run on, unchanged,
-  right beside one of its sides is no landmark, whatever ends them on the
-  other (a mast, a robot, a neighbour standing there; the stripes' end); nor is
-  one whose colours run on beyond every side judged. Columns where another
-  candidate stands are not looked at (touching neighbours show their own bands
-  and bodies), but the rest of that side is: a real landmark right beside a
-  skirting board excuses none of the board. Nor does a robot's mast and camera
-  board in front of the stripes right beside the false one (what often ends
-  it): the stripes run on when they show again a little farther out (on every
-  side judged: farther out another object's own colours may show).
+- **An object, not stripes** (:mod:`.stripes`): beside a landmark, at the rows of its red band
+  and of its white body, lies something else, not both of its own colours again. A neighbouring
+  candidate excuses its columns (a touching landmark shows its own bands there) unless it is
+  rejected itself (:func:`verdicts`).
+- **No twin** (:func:`twins`): a candidate of the same size beside it, its axis closer than
+  two robots' landmarks can stand, makes both pieces of one wide thing (a flag's or a can's run
+  cut into silhouettes).
 
 Levels are taken in linear light over the middle three fifths of the
 candidate's visible columns (limbs darken and mix with the background); of
@@ -73,19 +64,18 @@ from .edges import linear_table
 from .model import normalised
 from .params import ModelParams
 from .stats import percentile
+from .stripes import SAMPLES, striped
 from .types import CameraIntrinsics, LandmarkGeometry
 
+# twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
+ROBOT_APART_M, TWIN_PX = 0.08, 1.5
+JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in a piece's middle (linear)
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
-SAMPLES = 24  # rows and columns sampled per region, at most
 # height check: the tolerance is at least this, or 3 fitted sigmas ...
 HEIGHT_MIN_TOL_M = 0.03
 # ... plus the camera rocking (tan 0.5 deg) times the depth: a robot tilts on its wheels
 PITCH_WOBBLE = 0.0087
-# stripes: the colour beside the candidate, 0.15-0.6 of its width out, matches its own within this (log, per channel)
-SIDE_REACH = (0.15, 0.6)
-SIDE_WINDOWS, SIDE_STEP = 3, 0.45  # ... or in a window as wide this much farther out, up to 1.5 widths beyond a side
-SAME_COLOUR_LOG = 0.25
 
 
 def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float], channel: int, pct: float) -> float:
@@ -99,100 +89,57 @@ def _level(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]
     return percentile(bgr[r0:r1:rs, c0:c1:cs, channel], pct, linear_table())
 
 
-def _colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[List[float]]:
-    """Linear RGB (B, G, R order) of a region's median 8-bit colour, ``None`` when the region is empty."""
-    h, w = bgr.shape[:2]
-    r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
-    c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
-    if r1 <= r0 or c1 <= c0:
-        return None
-    rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
-    # the median: a thin line of another colour in the region (a brick wall's mortar, a mast's edge) moves it not
-    # (np.median's values; a sort of the few sampled pixels costs a third of its call)
-    sub = np.sort(bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), axis=0)
-    n = sub.shape[0]
-    return [((lo + hi) / 510.0) ** 2.2 for lo, hi in zip(sub[(n - 1) // 2].tolist(), sub[n // 2].tolist())]
+def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: LandmarkGeometry,
+          cam: CameraIntrinsics) -> bool:
+    """Whether ``o`` stands beside ``c`` at so nearly its range and so close that no robot could carry it.
 
-
-def _same(a: Optional[List[float]], b: Optional[List[float]]) -> bool:
-    return a is not None and b is not None and all(
-        abs(math.log((x + 0.01) / (y + 0.01))) <= SAME_COLOUR_LOG for x, y in zip(a, b))
-
-
-def _free(side: Tuple[float, float], boxes: Sequence[Tuple[float, float]]) -> Optional[Tuple[float, float]]:
-    """The widest part of the column span ``side`` that no box's columns cover (``None``: under a third is free)."""
-    cuts = sorted((max(lo, side[0]), min(hi, side[1])) for lo, hi in boxes if lo < side[1] and hi > side[0])
-    best, at = (side[0], side[0]), side[0]
-    for lo, hi in [*cuts, (side[1], side[1])]:
-        if lo - at > best[1] - best[0]:
-            best = (at, lo)
-        at = max(at, hi)
-    return best if best[1] - best[0] >= max(1.0, (side[1] - side[0]) / 3) else None
-
-
-def _sides(c: BandCentroids, boxes: Sequence[Tuple[float, float]],
-           frame_w: int) -> List[Tuple[bool, List[Tuple[float, float]]]]:
-    """Per side of ``c`` judged (its nearest window free), whether its run was cut there and the free column spans
-    of its windows, nearest first (farther windows only on a cut side: one that ends at its limb shows what lies
-    beside it)."""
-    x, _, w, _ = c.bbox_px
-    cand = c.candidate
-    out = []
-    for sign, cut in ((-1.0, cand is not None and cand.cut_left), (1.0, cand is not None and cand.cut_right)):
-        found: List[Tuple[float, float]] = []
-        for k in range(SIDE_WINDOWS if cut else 1):
-            near, far = SIDE_REACH[0] + k * SIDE_STEP, SIDE_REACH[1] + k * SIDE_STEP
-            span = (x - far * w, x - near * w) if sign < 0 else (x + w + near * w, x + w + far * w)
-            if k and (span[0] < 0 or span[1] > frame_w - 1):  # a farther window past the frame's edge: none
-                break
-            free = _free(span, boxes)
-            if free:
-                found.append(free)
-            elif not k:  # a neighbour right beside it: the side is not judged (it shows the neighbour)
-                break
-        if found:
-            out.append((cut, found))
-    return out
-
-
-def striped(bgr: np.ndarray, c: BandCentroids, layers: Sequence[Tuple[float, float]],
-            others: Sequence[BandCentroids] = ()) -> bool:
-    """Whether the colours of ``layers`` (row spans) run on unchanged beyond the sides of ``c``.
-
-    Columns where another candidate stands are not looked at (a touching
-    neighbour shows its own bands and body there): a side is judged on what is
-    left of its window 0.15-0.6 of the width out, and a side whose window a
-    neighbour covers (two thirds or more) not at all. The layers run on beyond a
-    judged side when they show unchanged in that window or, where the run was
-    cut on that side (it ends at something other than a limb), in one of the
-    ``SIDE_WINDOWS - 1`` as wide stepping outwards (0.45 of the width each, on
-    what no neighbour covers): a thin thing in front of the stripes right beside
-    it (a robot's mast and camera board, which often end the false "landmark")
-    does not hide that they go on. Stripes: the layers show unchanged right
-    beside one side judged (no background beside a real landmark lines up red
-    and white with its band's and its body's rows), or beyond every side judged,
-    and at least one is. Colours are medians (a brick wall's mortar or a mast's
-    edge in a window moves them not).
+    Landmarks ride robots: their axes stand at least a robot's width apart (``ROBOT_APART_M``).
+    Two candidates right beside each other (``2 TWIN_PX``) with the same band rows (within ``TWIN_PX``: the
+    same size and height, so nearly the same depth) whose axes would stand closer than that are one
+    thing cut in pieces: a flag, a poster or a can as wide as several landmarks, its run split into
+    silhouettes; neither is a landmark. The depths two band spacings allow differ by up to
+    ``2 TWIN_PX`` over the spacing of the depth: far away two robots one behind the other image at
+    sizes the rows cannot tell apart, and such a pair is no twin.
     """
-    boxes = [(b[0] - 1.0, b[0] + b[2] + 1.0) for b in (o.bbox_px for o in others if o is not c)]  # a property: once
-    sides = _sides(c, boxes, bgr.shape[1])
-    if not sides:
+    if c is o:
         return False
-    x, _, w, _ = c.bbox_px
-    own: dict = {}  # each layer's own colour, measured when first needed
+    (x, _, w, _), (ox, _, ow, _) = c.bbox_px, o.bbox_px
+    if not (abs(ox - (x + w)) <= 2 * TWIN_PX or abs(x - (ox + ow)) <= 2 * TWIN_PX):  # right beside it, or no twin
+        return False
+    spacing = c.blue_xy_px[1] - c.red_xy_px[1]
+    if spacing <= 0 or max(abs(c.red_xy_px[1] - o.red_xy_px[1]), abs(c.blue_xy_px[1] - o.blue_xy_px[1])) > TWIN_PX:
+        return False
+    depth_m = geometry.band_spacing_m * cam.fy_px / spacing
+    apart_m = abs(c.red_xy_px[0] + c.blue_xy_px[0] - o.red_xy_px[0] - o.blue_xy_px[0]) / 2 * depth_m / cam.fx_px
+    return math.hypot(apart_m, depth_m * 2 * TWIN_PX / spacing) < ROBOT_APART_M and not limbs_between(bgr, c, o)
 
-    def same(rows: Tuple[float, float], span: Tuple[float, float]) -> bool:
-        if rows not in own:
-            own[rows] = _colour(bgr, rows, (x + 0.2 * w, x + 0.8 * w))
-        return _same(own[rows], _colour(bgr, rows, span))
 
-    # body first: beside most real landmarks it is the background, and one differing layer ends the test
-    def runs_on(span: Tuple[float, float]) -> bool:
-        return all(same(rows, span) for rows in reversed(layers))
+def limbs_between(bgr: np.ndarray, c: BandCentroids, o: BandCentroids) -> bool:
+    """Whether the white body darkens where ``c`` and ``o`` meet: two cylinders' limbs, not one surface.
 
-    if any(not cut and runs_on(windows[0]) for cut, windows in sides):  # beside a limb that is none
-        return True
-    return all(any(map(runs_on, windows)) for _, windows in sides)
+    A cylinder's surface turns away from the camera at its limbs: lit by anything but light the
+    same from every side, one limb at least is darker than its middle, and where two landmarks
+    touch two limbs meet. A flag is as light at the cut as either side; a can's surface turns
+    smoothly through it. The darkest column within 2 px of the meeting (median over the middle
+    of the body's rows) against the lighter of the two pieces' middle fifths, in linear light.
+    """
+    a, b = sorted((c, o), key=lambda k: k.bbox_px[0])
+    h, w = bgr.shape[:2]
+    ry, by = c.red_xy_px[1], c.blue_xy_px[1]
+    r0, r1 = max(0, round(ry + 0.35 * (by - ry))), min(h, round(by - 0.35 * (by - ry)) + 1)
+    meet = round(0.5 * (a.bbox_px[0] + a.bbox_px[2] + b.bbox_px[0]))
+
+    def columns(c0: float, c1: float) -> np.ndarray:
+        c0, c1 = max(0, round(c0)), min(w, round(c1))
+        if r1 <= r0 or c1 <= c0:
+            return np.zeros(0)
+        return (np.median(bgr[r0:r1, c0:c1].astype(np.float64).mean(axis=2), axis=0) / 255.0) ** 2.2
+
+    joint = columns(meet - 2, meet + 3)
+    middles = [columns(k.bbox_px[0] + 0.4 * k.bbox_px[2], k.bbox_px[0] + 0.6 * k.bbox_px[2] + 1) for k in (a, b)]
+    if not len(joint) or not all(len(m) for m in middles):
+        return True  # nothing to judge: not one thing
+    return float(joint.min()) < JUNCTION_DIP * max(float(np.median(m)) for m in middles)
 
 
 def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
@@ -237,6 +184,8 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
             return f"its centre is {100 * off:+.1f} cm off the height where landmarks stand"
     elif cand is not None and cand.red_merged and cand.blue_merged:
         return "both bands merge with their backgrounds: no edge of the landmark's own"
+    if cam is not None and any(twins(bgr, c, o, geometry, cam) for o in others):
+        return "a candidate of its size beside it, closer than two robots' landmarks can stand: one thing cut"
     ry, by = c.red_xy_px[1], c.blue_xy_px[1]
     spacing = by - ry
     if spacing <= 0:
@@ -259,7 +208,28 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     return None
 
 
+def verdicts(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry,
+             model: Optional[ModelParams] = None, cam: Optional[CameraIntrinsics] = None) -> List[Optional[str]]:
+    """:func:`rejection` of each candidate, its neighbours the candidates not rejected.
+
+    A neighbour excuses its columns from the stripes test because a landmark shows its own bands
+    and body there; a "neighbour" rejected is no landmark, and stripes often hold several false
+    candidates side by side (a skirting board cut by masts and robots), each excusing the next.
+    The candidates passing are judged again against those still passing, once more at most.
+    """
+    why = [rejection(bgr, c, geometry, model, cam, found) for c in found]
+    for _ in range(2):
+        kept = [c for c, w in zip(found, why) if w is None]
+        if len(kept) in (0, len(found)):
+            break
+        again = [rejection(bgr, c, geometry, model, cam, kept) if w is None else w for c, w in zip(found, why)]
+        if again == why:
+            break
+        why = again
+    return why
+
+
 def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry,
              model: Optional[ModelParams] = None, cam: Optional[CameraIntrinsics] = None) -> List[BandCentroids]:
-    """The candidates that pass every check of :func:`rejection`, in their order."""
-    return [c for c in found if rejection(bgr, c, geometry, model, cam, found) is None]
+    """The candidates that pass every check of :func:`rejection` (:func:`verdicts`), in their order."""
+    return [c for c, w in zip(found, verdicts(bgr, found, geometry, model, cam)) if w is None]

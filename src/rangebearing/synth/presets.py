@@ -25,6 +25,8 @@ an auto-exposed Bayer camera:
 The photoreal presets (:mod:`.photoreal`) put those scenes through the Pi
 Camera v1's lens and ISP and richer rooms: ``photoreal``, ``photoreal-crowd``;
 ``photoreal-alt`` (:mod:`.photoreal_alt`) through another camera and other paint.
+``mimic`` (:mod:`.mimics`): red/white/blue things that are no landmark (flags, a red cup on a
+white box on a blue mat, striped cans, a room's own stripes).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from . import sampling as d
 from .camera import landmark_bbox_px
 from .clutter import clutter_scene
 from .crowd import crowd_scene, far_scene, lighting_scene, occlusion_scene, rooms_scene
+from .mimics import MIMIC_HELP, MIMIC_PRESET, mimic_scene
 from .motion import crowd_sequence
 from .photoreal import PHOTOREAL_HELP, PHOTOREAL_PRESETS, photoreal_scene, photoreal_sequence
 from .photoreal_alt import ALT_HELP, ALT_PRESET, alt_scene
@@ -51,7 +54,7 @@ from .touching import touching_scene
 
 ORIGINAL_PRESETS = ("paper", "wide", "clutter", "multi", "sample")
 CROWD_PRESETS = ("occlusion", "touching", "crowd", "far", "lighting", "crowd-moving", "rooms")
-PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS + (ALT_PRESET,)
+PRESETS = ORIGINAL_PRESETS + CROWD_PRESETS + PHOTOREAL_PRESETS + (ALT_PRESET, MIMIC_PRESET)
 SAMPLE_FPS = 30.0
 PRESET_HELP = {
     "paper": "one landmark at d_v 0.28-0.72 m, |bearing| <= 25 deg",
@@ -70,6 +73,7 @@ PRESET_HELP = {
                     "robot column keeps each robot's identity",
     **PHOTOREAL_HELP,
     **ALT_HELP,
+    **MIMIC_HELP,
 }
 
 
@@ -174,7 +178,7 @@ def sample_scene(base: Scene, paths: Tuple[Wander, ...], t_s: float) -> Scene:
 
 
 _NEWER = {"occlusion": occlusion_scene, "touching": touching_scene, "crowd": crowd_scene,
-          "far": far_scene, "lighting": lighting_scene, "rooms": rooms_scene}
+          "far": far_scene, "lighting": lighting_scene, "rooms": rooms_scene, MIMIC_PRESET: mimic_scene}
 
 
 def random_scene(rng: np.random.Generator, preset: str,

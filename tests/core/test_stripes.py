@@ -1,0 +1,133 @@
+"""Stripes under camera noise and chains of false candidates (core/stripes.py, core/verify.verdicts)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from rangebearing.core.detect import BandCentroids
+from rangebearing.core.stripes import colour, log_error, same
+from rangebearing.core.structure import Candidate
+from rangebearing.core.types import LandmarkGeometry
+from rangebearing.core.verify import rejection, verdicts
+
+GEOMETRY = LandmarkGeometry()
+RED, WHITE, BLUE = (0.70, 0.07, 0.06), (0.85, 0.85, 0.85), (0.06, 0.12, 0.65)
+RED_WALL, SKIRTING, MAT = (0.45, 0.03, 0.03), (0.55, 0.55, 0.52), (0.05, 0.08, 0.45)
+GREY_WALL = (0.30, 0.30, 0.30)
+W, H, LM_W = 320, 110, 40  # frame; a landmark 40 px wide: red rows 20-35, body 35-75, blue 75-90
+RED_ROWS, BODY_ROWS, BLUE_ROWS = (20, 35), (35, 75), (75, 90)
+
+
+def encode(lin, noise=0.0, seed=0):
+    """Linear RGB -> 8-bit BGR, with Gaussian noise of ``noise`` 8-bit levels (a camera at high gain)."""
+    v = 255.0 * np.clip(lin, 0.0, 1.0)[..., ::-1] ** (1 / 2.2)
+    v = v + np.random.default_rng(seed).normal(0.0, noise, v.shape)
+    return np.clip(np.round(v), 0, 255).astype(np.uint8)
+
+
+def room(stripes=True):
+    """A red wall over a skirting board over a blue mat (``stripes``), or a grey wall over a grey floor."""
+    lin = np.empty((H, W, 3))
+    lin[:] = GREY_WALL
+    if stripes:
+        lin[: RED_ROWS[1]] = RED_WALL
+        lin[RED_ROWS[1] : BODY_ROWS[1]] = SKIRTING
+        lin[BODY_ROWS[1] :] = MAT
+    return lin
+
+
+def landmark(lin, x0):
+    out = lin.copy()
+    for rows, paint in ((RED_ROWS, RED), (BODY_ROWS, WHITE), (BLUE_ROWS, BLUE)):
+        out[rows[0] : rows[1], x0 : x0 + LM_W] = paint
+    return out
+
+
+def candidate(x0, cut=(False, False), width=LM_W):
+    red_box = (x0, RED_ROWS[0], width, RED_ROWS[1] - RED_ROWS[0])
+    blue_box = (x0, BLUE_ROWS[0], width, BLUE_ROWS[1] - BLUE_ROWS[0])
+    cand = Candidate(red_box, blue_box, 40.0, False, False, cut[0], cut[1], 1.0)
+    centre_x = x0 + 0.5 * width - 0.5
+    return BandCentroids((centre_x, 27.0), (centre_x, 82.0), red_box, blue_box, 600.0, 600.0, 90.0, 90.0,
+                         candidate=cand)
+
+
+def test_a_colours_noise_is_its_medians_standard_error():
+    lin = np.full((30, 30, 3), 0.2)
+    quiet, loud = colour(encode(lin, 1.0), (0, 29), (0, 29)), colour(encode(lin, 12.0), (0, 29), (0, 29))
+    assert np.allclose(quiet[0], loud[0], rtol=0.1)  # the median stays put
+    assert all(log_error(loud, k) > 5 * log_error(quiet, k) for k in range(3))  # its uncertainty grows with the noise
+    # one surface under heavy noise: the same colour; a red wall and a white body: not, however noisy
+    img = encode(room(), 14.0, seed=3)
+    assert same(colour(img, RED_ROWS, (10, 40)), colour(img, RED_ROWS, (200, 230)))
+    lm = encode(landmark(room(False), 100), 14.0, seed=3)
+    assert not same(colour(lm, BODY_ROWS, (110, 130)), colour(lm, RED_ROWS, (110, 130)))
+
+
+def dim_room(stripes=True):
+    """:func:`room` with a dim red wall: its green and blue channels a few 8-bit levels at high gain."""
+    lin = room(stripes)
+    if stripes:
+        lin[: RED_ROWS[1]] = (0.2, 0.03, 0.02)
+    return lin
+
+
+@pytest.mark.parametrize("width", [12, 20])
+def test_stripes_under_camera_noise_are_still_stripes(width):
+    # a far candidate on a dim red wall over a skirting board, 24 levels of noise: every draw is stripes
+    c = candidate(140, cut=(True, True), width=width)
+    assert all("stripes" in (rejection(encode(dim_room(), 24.0, seed=s), c, GEOMETRY) or "") for s in range(30))
+    # a real landmark as wide before a grey wall, as noisy: never
+    lin = dim_room(False)
+    for rows, paint in ((RED_ROWS, RED), (BODY_ROWS, WHITE), (BLUE_ROWS, BLUE)):
+        lin[rows[0] : rows[1], 140 : 140 + width] = paint
+    assert all(rejection(encode(lin, 24.0, seed=s), candidate(140, width=width), GEOMETRY) is None for s in range(30))
+
+
+def test_a_bright_channel_that_differs_is_another_colour_however_noisy():
+    # noise widens the tolerance of a saturated colour's dark channels only: red 0.2 against red 0.3
+    a, b = np.full((12, 12, 3), 0.2), np.full((12, 12, 3), 0.2)
+    a[..., 0], a[..., 1:] = 0.30, 0.02
+    b[..., 0], b[..., 1:] = 0.20, 0.02
+    assert not same(colour(encode(a, 24.0, 1), (0, 11), (0, 11)), colour(encode(b, 24.0, 2), (0, 11), (0, 11)))
+    assert same(colour(encode(a, 24.0, 1), (0, 11), (0, 11)), colour(encode(a, 24.0, 2), (0, 11), (0, 11)))
+
+
+def test_false_candidates_side_by_side_do_not_excuse_each_other():
+    # masts cut a skirting board into pieces: three false candidates in a row, each right beside the next
+    img = encode(room(), 4.0, seed=2)
+    row = [candidate(x, cut=(True, True)) for x in (60, 102, 144)]
+    assert rejection(img, row[1], GEOMETRY, others=row) is None  # each neighbour hides what lies beside it
+    assert all(w is not None and "stripes" in w for w in verdicts(img, row, GEOMETRY))
+    # two real landmarks touching before a grey wall: each excuses the other's columns and both pass
+    pair = landmark(landmark(room(False), 100), 140)
+    real = [candidate(100, cut=(False, True)), candidate(140, cut=(True, False))]
+    assert verdicts(encode(pair, 4.0), real, GEOMETRY) == [None, None]
+
+
+def test_a_real_landmark_beside_a_false_one_is_judged_on_what_it_really_stands_beside():
+    # a real landmark before a grey wall, a false candidate on the stripes of a poster right beside it
+    lin = room(False)
+    lin[:, 180:] = room()[:, 180:]
+    img = encode(landmark(lin, 140), 3.0)
+    fake = dataclasses.replace(candidate(182, cut=(True, True)))
+    got = verdicts(img, [candidate(140), fake], GEOMETRY)
+    assert got[0] is None and "stripes" in got[1]
+
+
+def test_a_flag_cut_into_silhouettes_is_no_row_of_landmarks():
+    from rangebearing.core.types import CameraIntrinsics
+    from rangebearing.core.verify import twins
+
+    cam = CameraIntrinsics()
+    # a wide flag on the wall, its stripes in the landmark's proportions: the run is split into three
+    # silhouettes of one size, each right beside the next, at 0.6 m (55 px between the band centres)
+    img = encode(room(), 3.0)
+    row = [candidate(x, cut=(x > 60, x < 140)) for x in (60, 100, 140)]
+    assert twins(img, row[0], row[1], GEOMETRY, cam) and not twins(img, row[0], row[2], GEOMETRY, cam)
+    assert all(w is not None and "one thing cut" in w for w in verdicts(img, row, GEOMETRY, cam=cam))
+    # the same pieces far away (their rows 3x closer together: 1.9 m) may be two robots' landmarks, one
+    # behind the other: sizes that differ by a few per cent no longer show in the rows
+    far = [dataclasses.replace(c, red_xy_px=(c.red_xy_px[0], 60.0), blue_xy_px=(c.blue_xy_px[0], 78.0)) for c in row]
+    assert not twins(img, far[0], far[1], GEOMETRY, cam)
