@@ -74,6 +74,19 @@ def test_of_one_landmark_found_twice_the_taller_white_body_stays():
     assert merge_candidates([whole], [cand(399, y=232, w=14, band=6, white=19)], 8) == [whole]  # alike: the first
 
 
+def test_a_nearer_landmark_replaces_every_piece_of_it_the_first_search_found():
+    # rooms 10113 frame 48: the near landmark (0.2 m) under the camera's balance; under grey-world
+    # only its robot's plate over the bumper and a speck in its body, two pieces within its place
+    whole = cand(126, y=146, w=116, band=52, white=140)
+    plate = Candidate((126, 292, 22, 12), (126, 338, 22, 12), 34.0, False, False, True, True, 1.0)
+    speck = cand(212, y=332, w=4, band=2, white=6)
+    other = cand(462, y=208, w=34, band=14, white=38)
+    assert merge_candidates([other, plate, speck], [whole], 8) == [other, whole]
+    # ... but not one that is not clearly taller than each of them
+    alike = Candidate((126, 150, 116, 50), (126, 334, 116, 50), 134.0, False, False, False, False, 1.0)
+    assert merge_candidates([alike, speck], [whole], 8) == [alike, speck]
+
+
 def test_landmarks_side_by_side_or_one_on_its_robot_are_not_one():
     a = cand(10, w=20)
     assert merge_candidates([a], [cand(31, w=20)], 8) == [a, cand(31, w=20)]  # the next one along

@@ -75,15 +75,19 @@ def merge_candidates(first: Sequence[Candidate], more: Sequence[Candidate], max_
 
     Where both searches found one landmark, the one with the clearly taller white body stays: under
     one balance a mast or flag in front of the body may leave only a smaller red–white–blue piece of
-    it (its band's rim pixels in or out of a class), read as a landmark twice as far.
+    it (its band's rim pixels in or out of a class), read as a landmark twice as far. A landmark
+    clearly taller than each of several of ``first`` it shares most of its place with replaces them
+    all: being nearer it hides whatever lies there, so they are pieces of it (its robot's red top
+    plate over a pale bumper, a speck of edge noise in its band).
     """
     out = list(first[:max_landmarks])
     for c in more:
         same = [k for k, o in enumerate(out) if _same(c, o)]
         if not same and len(out) < max_landmarks:
             out.append(c)
-        elif len(same) == 1 and c.white_px > TALLER * out[same[0]].white_px:
+        elif same and all(c.white_px > TALLER * out[k].white_px for k in same):
             out[same[0]] = c
+            out = [o for k, o in enumerate(out) if k not in same[1:]]
     return out
 
 

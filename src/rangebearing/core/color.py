@@ -124,6 +124,72 @@ def hue_in(h: np.ndarray, hue_ranges: HueRanges) -> np.ndarray:
     return cv2.LUT(h, hue_table(tuple(map(tuple, hue_ranges))))
 
 
+CLIPPED_HUE_REACH = 15  # OpenCV hue units (30°) a clipped band's hue may lie beyond its class's range
+
+
+@functools.lru_cache(maxsize=16)
+def clipped_hue_tables(red_hue: Tuple[Tuple[int, int], ...], blue_hue: Tuple[Tuple[int, int], ...]
+                       ) -> Tuple[np.ndarray, np.ndarray]:
+    """``cv2.LUT`` tables (255 inside) of the red and the blue hues a *clipped* pixel of each class may show.
+
+    A band whose strongest channel clips (over-exposed: 1–2 stops over, a spotlight) keeps the
+    difference of its two lesser channels while its chroma, max − min, shrinks: its hue's offset
+    from the paint's primary grows by the clip factor (×2–4 at 1–2 stops over), a red band reading
+    orange or magenta, a blue one cyan or violet. Each class's range reaches ``CLIPPED_HUE_REACH``
+    further on both sides for clipped pixels; a hue both reaches take goes to the nearer range,
+    and none is taken from the other class's own range.
+    """
+    hue = np.arange(180)
+
+    def distance(ranges: Tuple[Tuple[int, int], ...]) -> np.ndarray:  # circular distance to the ranges (0 inside)
+        d = np.full(180, 180)
+        for lo, hi in ranges:
+            inside = (hue >= lo) & (hue <= hi)
+            off = np.minimum(np.minimum(np.abs(hue - lo), 180 - np.abs(hue - lo)),
+                             np.minimum(np.abs(hue - hi), 180 - np.abs(hue - hi)))
+            d = np.minimum(d, np.where(inside, 0, off))
+        return d
+
+    d_red, d_blue = distance(red_hue), distance(blue_hue)
+    tables = []
+    for mine, other in ((d_red, d_blue), (d_blue, d_red)):
+        table = np.zeros((256, 1), np.uint8)
+        table[:180, 0] = np.where((mine <= CLIPPED_HUE_REACH) & (mine < other) & (other > 0), 255, 0)
+        tables.append(table)
+    return tables[0], tables[1]
+
+
+def class_hues(h: np.ndarray, red_hue: HueRanges, blue_hue: HueRanges, clip: Optional[np.ndarray] = None
+               ) -> Tuple[np.ndarray, np.ndarray]:
+    """0/255 masks of the red and the blue hues; where ``clip`` (0/255) is set, :func:`clipped_hue_tables`'
+    wider ones."""
+    red_key, blue_key = tuple(map(tuple, red_hue)), tuple(map(tuple, blue_hue))
+    red, blue = cv2.LUT(h, hue_table(red_key)), cv2.LUT(h, hue_table(blue_key))
+    if clip is None or not cv2.countNonZero(clip):
+        return red, blue
+    red_wide, blue_wide = clipped_hue_tables(red_key, blue_key)
+    return (cv2.bitwise_or(red, cv2.bitwise_and(cv2.LUT(h, red_wide), clip)),
+            cv2.bitwise_or(blue, cv2.bitwise_and(cv2.LUT(h, blue_wide), clip)))
+
+
+CLIPPED_HUE_S_MIN = 80  # a clipped pixel paler than this (a white body's highlight: S < 80) keeps the plain ranges
+
+
+def clip_of(s: np.ndarray, v: np.ndarray, clipped: Optional[np.ndarray] = None) -> np.ndarray:
+    """0/255 mask of the pixels :func:`class_hues` reads with the clipped pixels' wider hues: clipped after
+    the gains (V ≥ ``CLIPPED``) or, per ``clipped``, before them, and no paler than ``CLIPPED_HUE_S_MIN``.
+
+    A white body's clipped highlight under a tinted light (a red wall's bounce, a warm lamp) reads
+    (255, 220, 200): its hue is a red band's widened one, but it is as pale as the body the column
+    scan calls white, and it must stay white there.
+    """
+    _, clip = cv2.threshold(v, CLIPPED - 1, 255, cv2.THRESH_BINARY)
+    if clipped is not None:
+        clip = cv2.max(clip, clipped)
+    _, vivid = cv2.threshold(s, CLIPPED_HUE_S_MIN - 1, 255, cv2.THRESH_BINARY)
+    return cv2.bitwise_and(clip, vivid)
+
+
 def clipped_mask(bgr: np.ndarray) -> np.ndarray:
     """0/255 mask of pixels with any channel at ``CLIPPED`` or above, of a BGR uint8 image *before* its gains.
 
@@ -172,7 +238,8 @@ def class_masks(
     (``clipped``: see :func:`sv_gate`)."""
     h, s, v = cv2.split(hsv)
     sv = sv_gate(s, v, s_min, v_min, clipped)
-    return cv2.bitwise_and(hue_in(h, red_hue), sv), cv2.bitwise_and(hue_in(h, blue_hue), sv)
+    red, blue = class_hues(h, red_hue, blue_hue, clip_of(s, v, clipped))
+    return cv2.bitwise_and(red, sv), cv2.bitwise_and(blue, sv)
 
 
 # a second look (core/balance.py): the class floors another camera's darker or paler bands fall under

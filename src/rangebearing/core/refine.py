@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import CLIPPED, Gains, apply_gains, hue_table, ramp_table, to_hsv
+from .color import CLIPPED, CLIPPED_HUE_S_MIN, Gains, apply_gains, class_hues, ramp_table, to_hsv
 from .params import DetectionParams
 from .types import XY, BBox
 
@@ -70,13 +70,15 @@ def band_weights(
     hue, sat, val = cv2.split(hsv.reshape(n * h, w, 3))
     gate = np.empty_like(hue)
     split = n_red * h
+    clip = cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]
+    # the clipped pixels whose hue may lie wider (:func:`.color.clip_of`, :func:`.color.clipped_hue_tables`)
+    wide = cv2.bitwise_and(clip, cv2.threshold(sat, CLIPPED_HUE_S_MIN - 1, 255, cv2.THRESH_BINARY)[1])
     if split:
-        cv2.LUT(hue[:split], hue_table(cfg.red_hue), dst=gate[:split])
+        gate[:split] = class_hues(hue[:split], cfg.red_hue, cfg.blue_hue, wide[:split])[0]
     if split < n * h:
-        cv2.LUT(hue[split:], hue_table(cfg.blue_hue), dst=gate[split:])
+        gate[split:] = class_hues(hue[split:], cfg.red_hue, cfg.blue_hue, wide[split:])[1]
     # :func:`.color.sv_gate` at S ≥ 1, V ≥ min(v_min, 10): (S ≥ 1 or V clipped) and V ≥ that floor (a clipped
     # V is above it), in three thresholds instead of four, the clipped one kept for ``w_x``
-    clip = cv2.threshold(val, CLIPPED - 1, 255, cv2.THRESH_BINARY)[1]
     lit = cv2.threshold(val, min(cfg.v_min, 10) - 1, 255, cv2.THRESH_BINARY)[1]
     gate = cv2.bitwise_and(gate, cv2.bitwise_and(cv2.max(cv2.threshold(sat, 0, 255, cv2.THRESH_BINARY)[1], clip), lit))
     core = cv2.bitwise_and(gate, cv2.threshold(sat, cfg.s_min - 1, 255, cv2.THRESH_BINARY)[1])

@@ -14,7 +14,7 @@ from typing import Optional, Tuple
 import cv2
 import numpy as np
 
-from .color import Gains, apply_gains, clipped_mask, hue_in, sv_gate, to_hsv
+from .color import Gains, apply_gains, class_hues, clip_of, clipped_mask, sv_gate, to_hsv
 from .params import DetectionParams
 
 
@@ -40,8 +40,8 @@ class SearchImage:
         """:func:`.color.class_masks` of the HSV image at these floors (0/255 uint8; the same arrays' values)."""
         if self._hsv_split is None:
             self._hsv_split = tuple(cv2.split(self.hsv))
-            h = self._hsv_split[0]
-            self._hues = (hue_in(h, cfg.red_hue), hue_in(h, cfg.blue_hue))
+            h, s, v = self._hsv_split
+            self._hues = class_hues(h, cfg.red_hue, cfg.blue_hue, clip_of(s, v, self.clipped()))
         _, s, v = self._hsv_split
         red_h, blue_h = self._hues  # type: ignore[misc]
         sv = sv_gate(s, v, s_min, v_min, self.clipped())
