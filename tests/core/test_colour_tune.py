@@ -73,3 +73,17 @@ def test_widen_wraps_and_the_ladder_starts_with_the_current_thresholds():
     ladder = search_ladder(((0, 10),), ((98, 132),), 90, 25)
     assert ladder[0] == (((0, 10),), ((98, 132),), 90, 25)
     assert ladder[-1][2] < 90 and ladder[-1][3] < 25
+
+
+def test_the_second_looks_hues_reach_further_on_both_sides_of_each_class():
+    from rangebearing.core.colour_tune import RELAXED_HUE, relaxed_hues
+    from rangebearing.core.params import DetectionParams
+
+    cfg = DetectionParams(red_hue=((0, 10), (165, 179)), blue_hue=((98, 132),))
+    relaxed = relaxed_hues(cfg)
+    h = np.arange(180, dtype=np.uint8).reshape(1, -1)
+    red, blue = (np.flatnonzero(hue_in(h, r)).tolist() for r in (relaxed.red_hue, relaxed.blue_hue))
+    assert red == [*range(0, 11 + RELAXED_HUE), *range(165 - RELAXED_HUE, 180)]  # magenta and orange paint
+    assert blue == list(range(98 - RELAXED_HUE, 133 + RELAXED_HUE))  # cyan and violet paint
+    assert not set(red) & set(blue)
+    assert (relaxed.s_min, relaxed.v_min) == (cfg.s_min, cfg.v_min)  # the floors are relaxed_floors' business

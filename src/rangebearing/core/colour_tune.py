@@ -8,12 +8,14 @@ back, which may split the range in two, e.g. ``[(0, 9), (170, 179)]``.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
 from ..errors import CalibrationError
+from .params import DetectionParams
 from .types import XY
 
 HueRange = Tuple[int, int]
@@ -144,6 +146,23 @@ def widen(hue: Sequence[HueRange], by: int) -> Tuple[HueRange, ...]:
         else:
             out.append((lo, hi))
     return tuple(out)
+
+
+RELAXED_HUE = 6  # OpenCV hue units (12°) the second look's hue ranges reach further on each side
+
+
+def relaxed_hues(cfg: DetectionParams) -> DetectionParams:
+    """``cfg`` with the hue ranges of the second look (:func:`.balance.second_look`): each reaching
+    ``RELAXED_HUE`` further on both sides.
+
+    The second look is for another camera's and another maker's bands (:func:`.color.relaxed_floors`):
+    paint whose hue is ours turned by up to ±15° in display space (a crimson leaning magenta, a blue
+    leaning violet or cyan), a tone curve or a white balance that turns it further. Frame-wide these
+    ranges would let in orange and violet things; the second look's candidates must stand apart from
+    every landmark found and be no stripe (cut on both sides), as at its lower floors. The calibrated
+    red and blue ranges lie far apart (blue ends near 132, red starts near 165), so the two never meet.
+    """
+    return dataclasses.replace(cfg, red_hue=widen(cfg.red_hue, RELAXED_HUE), blue_hue=widen(cfg.blue_hue, RELAXED_HUE))
 
 
 def search_ladder(

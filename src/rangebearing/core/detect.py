@@ -29,6 +29,7 @@ from .._compat import frozen
 from .arc import arc_scale
 from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
+from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, median_filter, none_apart_filtered
 from .measure import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
@@ -103,7 +104,8 @@ def search_candidates(
 ) -> Found:
     """Landmark candidates in a frame downscaled by ``cfg.downscale``, and whether they explain every
     band-coloured region (:func:`.structure.search`). ``relaxed``: the second look
-    (:func:`.balance.second_look`) with lower saturation and value floors (:func:`.color.relaxed_floors`),
+    (:func:`.balance.second_look`) with lower saturation and value floors (:func:`.color.relaxed_floors`)
+    and wider hue ranges (:func:`.colour_tune.relaxed_hues`),
     given the ``(x0, y0, x1, y1)`` boxes (full resolution) of the landmarks already found: it is not
     searched when the masks hold no red or no blue outside them (a landmark apart from them has both),
     judged before the band filter where that is exact (:func:`.denoise.none_apart_filtered`).
@@ -115,7 +117,7 @@ def search_candidates(
         if hsv_of is not None:
             hsv_of[gains] = img
     s_min, v_min = (cfg.s_min, cfg.v_min) if relaxed is None else relaxed_floors(cfg.s_min, cfg.v_min)
-    red, blue = img.class_masks(cfg, s_min, v_min)
+    red, blue = img.class_masks(cfg if relaxed is None else relaxed_hues(cfg), s_min, v_min)
     if relaxed is not None and none_apart_filtered(red, blue, relaxed, cfg.downscale, ksize):
         return Found([], lambda: True)  # as search_apart says of filtered masks with nothing apart
     red, blue = band_masks(red, blue, ksize)

@@ -9,7 +9,7 @@ second look costs one gate and two ``and``\\ s instead of a second conversion.
 
 from __future__ import annotations
 
-from typing import Optional, Tuple
+from typing import Dict, Optional, Tuple
 
 import cv2
 import numpy as np
@@ -27,7 +27,7 @@ class SearchImage:
         self.small, self.gains = small, gains
         self.hsv: np.ndarray = to_hsv(apply_gains(small, gains))
         self._hsv_split: Optional[Tuple[np.ndarray, ...]] = None
-        self._hues: Optional[Tuple[np.ndarray, np.ndarray]] = None
+        self._hues: Dict[tuple, Tuple[np.ndarray, np.ndarray]] = {}  # the hue masks by the ranges they are of
         self._clipped: Optional[Tuple[Optional[np.ndarray]]] = None
 
     def clipped(self) -> Optional[np.ndarray]:
@@ -40,9 +40,10 @@ class SearchImage:
         """:func:`.color.class_masks` of the HSV image at these floors (0/255 uint8; the same arrays' values)."""
         if self._hsv_split is None:
             self._hsv_split = tuple(cv2.split(self.hsv))
-            h, s, v = self._hsv_split
-            self._hues = class_hues(h, cfg.red_hue, cfg.blue_hue, clip_of(s, v, self.clipped()))
-        _, s, v = self._hsv_split
-        red_h, blue_h = self._hues  # type: ignore[misc]
+        h, s, v = self._hsv_split
+        key = (tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)))
+        if key not in self._hues:
+            self._hues[key] = class_hues(h, cfg.red_hue, cfg.blue_hue, clip_of(s, v, self.clipped()))
+        red_h, blue_h = self._hues[key]
         sv = sv_gate(s, v, s_min, v_min, self.clipped())
         return cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv)

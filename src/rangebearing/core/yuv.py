@@ -30,6 +30,7 @@ import numpy as np
 
 from .._compat import frozen
 from .color import UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
+from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, none_apart_filtered
 from .params import DetectionParams
 from .structure import Found, search, search_apart
@@ -261,7 +262,7 @@ def yuv_search(
     y_half = half_luma(yuv.y) if y_half is None else y_half
     if relaxed is not None:
         s_min, v_min = relaxed_floors(cfg.s_min, cfg.v_min)
-        cfg = dataclasses.replace(cfg, s_min=s_min, v_min=v_min)
+        cfg = dataclasses.replace(relaxed_hues(cfg), s_min=s_min, v_min=v_min)
     red, blue = chroma_masks(yuv, cfg, gains, y_half)
     if relaxed is not None and none_apart_filtered(red, blue, relaxed, 2, ksize):
         return Found([], lambda: True)  # as search_apart says of filtered masks with nothing apart
