@@ -195,6 +195,16 @@ def test_the_second_look_adds_only_landmarks_apart_from_those_found():
     assert second_look(found, [touching, apart, striped, one_side]) == [apart, one_side]
 
 
+def test_the_second_look_takes_the_frames_edge_for_a_cut_side():
+    # photoreal-crowd 19032 frame 15: an orange wall over a white one over a dark box, cut out of the frame's
+    # left edge and cut on its right: it shows no limb, as a stripe between two cuts does
+    at_edge = dataclasses.replace(cand(0, w=50), cut_right=True)
+    whole_at_edge = cand(0, w=50)  # a limb on its right: a landmark coming into view
+    right_edge = dataclasses.replace(cand(110, w=50), cut_left=True)  # out of a 160-pixel frame's right edge
+    assert second_look([], [at_edge, whole_at_edge, right_edge], 160) == [whole_at_edge]
+    assert second_look([], [at_edge, whole_at_edge, right_edge]) == [at_edge, whole_at_edge, right_edge]
+
+
 def test_the_second_look_changes_neither_the_landmarks_found_nor_their_gains():
     img, c = frame_with_body((120, 160, 200))
     far = cand(120, w=10, band=4, white=12)

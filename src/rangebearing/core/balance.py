@@ -30,6 +30,7 @@ import numpy as np
 
 from .color import CLIPPED, DARK, UNIT_GAINS, Gains
 from .denoise import Box
+from .limbs import cut_sides
 from .stats import median_rows
 from .structure import Candidate, Found
 
@@ -203,11 +204,12 @@ def balanced_search(
     measured = white_body_gains(bgr, cands) or gains
     if relaxed is not None and len(cands) < max_landmarks:
         more = _candidates(relaxed(gains, [_box(c) for c in cands]))
-        cands = cands + second_look(cands, more)[: max_landmarks - len(cands)]
+        cands = cands + second_look(cands, more, bgr.shape[1])[: max_landmarks - len(cands)]
     return cands, measured
 
 
-def second_look(found: Sequence[Candidate], more: Sequence[Candidate]) -> List[Candidate]:
+def second_look(found: Sequence[Candidate], more: Sequence[Candidate], frame_w_px: Optional[int] = None
+                ) -> List[Candidate]:
     """The candidates of a search with lower colour floors (``more``) that are landmarks the
     searches at the normal floors missed: wholly apart from every one of ``found``, and ending in
     a limb on at least one side.
@@ -221,9 +223,12 @@ def second_look(found: Sequence[Candidate], more: Sequence[Candidate]) -> List[C
     wall over a white skirting board over a blue floor, a dark skirting board read as a pale
     blue band) run on beyond both sides of whatever the search cuts out of them: a candidate cut
     on both sides is no second-look landmark, though a real one between two neighbours may be.
+    The frame's edge (``frame_w_px`` wide) shows no limb either: a stripe running out of the frame
+    is cut there (:func:`.limbs.cut_sides`).
     """
     boxes = [_box(c) for c in found]
-    return [c for c in more if not (c.cut_left and c.cut_right) and not any(_meet(_box(c), b) for b in boxes)]
+    return [c for c in more if not all(cut_sides(c, frame_w_px) if frame_w_px else (c.cut_left, c.cut_right))
+            and not any(_meet(_box(c), b) for b in boxes)]
 
 
 def _box(c: Candidate) -> Box:
