@@ -132,3 +132,53 @@ def _cuts(boxes: Sequence[BBox], w: int, h: int, s: int) -> Tuple[Cut, ...]:
 def came_in(now: SideCounts, recorded: SideCounts) -> bool:
     """Whether a side gained ``NEW_COLUMNS`` landmark-like columns since the counts a full scan recorded."""
     return any(n >= r + NEW_COLUMNS for n, r in zip(now, recorded))
+
+
+# Landmarks coming out from behind a followed one. A nearer landmark moving sideways uncovers what stands
+# behind it, and a farther one walks out from behind it: either comes out right beside the nearer one's limb,
+# where no window looks. The same landmark-like columns are counted in two strips beside every followed
+# landmark's box (each as wide as the box, its rows grown by half its height: one farther away is smaller and
+# nearer the horizon), the followed landmarks' columns blanked. A full scan records the count it leaves; a
+# frame whose count gained ``NEW_COLUMNS`` is scanned whole.
+BESIDE_GAP_PX = 2  # full-resolution columns between a box and its strips: its own limb's mixed pixels
+
+
+def beside_count(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> int:
+    """Landmark-like columns (half resolution, as :func:`side_colour` counts them) right beside ``boxes``.
+
+    Parameters
+    ----------
+    bgr : (H, W, 3) uint8
+        The full-resolution frame.
+    cfg : DetectionParams
+        Hue ranges and the S/V thresholds of the full scan.
+    gains : Gains
+        The balance the full scan classified with.
+    boxes : sequence of BBox
+        Full-resolution boxes of the followed landmarks (their columns are not counted).
+    """
+    h, w = bgr.shape[:2]
+    strips, xs = [], []
+    for bx, by, bw, bh in boxes:
+        y0, y1 = max(0, by - bh // 2), min(h, by + bh + bh // 2)
+        left, right = bx - BESIDE_GAP_PX, bx + bw + BESIDE_GAP_PX
+        for x0, x1 in ((left - bw, left), (right, right + bw)):
+            x0, x1 = max(0, x0), min(w, x1)
+            if x1 - x0 >= 2 and y1 - y0 >= 2:
+                strips.append(bgr[y0:y1:2, x0:x1:2])
+                xs.append(np.arange(x0, x1, 2))
+    if not strips:
+        return 0
+    rows = max(s.shape[0] for s in strips)
+    img = np.zeros((rows, sum(s.shape[1] for s in strips), 3), np.uint8)  # black pads: no band colour
+    at = 0
+    for s in strips:
+        img[: s.shape[0], at : at + s.shape[1]] = s
+        at += s.shape[1]
+    red, blue = class_masks(to_hsv(apply_gains(img, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    x = np.concatenate(xs)
+    b = np.asarray(boxes, np.int64).reshape(-1, 4)
+    followed = ((x[:, None] >= b[None, :, 0]) & (x[:, None] < b[None, :, 0] + b[None, :, 2])).any(axis=1)
+    return int(np.count_nonzero((n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX) & ~followed))

@@ -15,7 +15,7 @@ a full scan or in tracking windows).
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable, Dict, List, Optional, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -27,7 +27,7 @@ from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
 from .model import in_envelope, reading, view_edges_rad
-from .newcomers import SideCounts, SideView, came_in, side_view
+from .newcomers import NEW_COLUMNS, SideCounts, SideView, beside_count, came_in, side_view
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
@@ -99,6 +99,7 @@ class Pipeline:
         self._since_scan = 0
         self._sides: SideCounts = (0, 0)
         self._side_view: Optional[SideView] = None  # the strips' counts as last classified (core/newcomers.py)
+        self._beside = 0  # landmark-like columns beside the tracks at the last full scan (newcomers.beside_count)
         self._gains: Gains = UNIT_GAINS
         self._identity = empty_state(0 if new_run else self._identity.next_id)
         self._size: Optional[Tuple[int, int]] = None  # the frame size the tracks were found in
@@ -152,7 +153,8 @@ class Pipeline:
                 kept, lost = step(bgr, self._tracks, det, self._gains, self.params.landmark, self.limits, cam.fy_px)
                 # a landmark lost in its window (gone astray, half hidden, changed): this frame is scanned
                 # whole, from the tracks as they were, as if its scan had been due; its reading is not missed
-                if not lost:
+                # ... or one came out from behind a followed one (core/newcomers.py): scanned whole, once
+                if not lost and self._beside_now(bgr, kept) < self._beside + NEW_COLUMNS:
                     self._tracks, self._lost = kept, lost
                     self._since_scan += 1
                     found = [t.bands for t in self._tracks]
@@ -194,6 +196,7 @@ class Pipeline:
                 if self.track:  # what the sides hold now, the landmarks found blanked (core/newcomers.py)
                     self._side_view = None
                     self._sides = self._sides_now(bgr)
+                    self._beside = self._beside_now(bgr, self._tracks)
                 # what lost a landmark (one passing behind another, coming out) is still under way: the next frame too
                 self._since_scan = det.full_scan_every - 1 if lost else 0
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
@@ -260,6 +263,10 @@ class Pipeline:
         boxes = [t.reach_px for t in self._tracks]
         self._side_view = side_view(bgr, self.params.detection, self._gains, boxes, self._side_view)
         return self._side_view.counts
+
+    def _beside_now(self, bgr: np.ndarray, tracks: Sequence[Track]) -> int:
+        """Landmark-like columns right beside ``tracks`` (:func:`.newcomers.beside_count`)."""
+        return beside_count(bgr, self.params.detection, self._gains, [t.bands.bbox_px for t in tracks])
 
     def _reading(self, c: BandCentroids, cam: CameraIntrinsics, bgr: np.ndarray) -> tuple:
         """A :class:`Landmark`'s fields up to ``visible``, in its order (the ids come after)."""
