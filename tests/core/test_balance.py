@@ -87,6 +87,17 @@ def test_a_nearer_landmark_replaces_every_piece_of_it_the_first_search_found():
     assert merge_candidates([alike, speck], [whole], 8) == [alike, speck]
 
 
+def test_pieces_of_one_body_found_as_several_all_give_way_to_the_whole():
+    # a cast turned half the white body blue under one balance: two slivers of red-white-blue at its middle
+    whole = cand(236, y=210, w=38, band=18, white=50)
+    pieces = [Candidate((256, 226, 4, 2), (256, 234, 4, 2), 6.0, True, True, True, True, 1.0),
+              Candidate((238, 226, 4, 2), (238, 232, 4, 2), 4.0, True, True, True, True, 1.0)]
+    other = cand(400)
+    assert merge_candidates([*pieces, other], [whole], 8) == [whole, other]
+    alike = cand(238, y=210, w=36, band=18, white=46)  # as tall as the whole: the first stays
+    assert merge_candidates([whole], [alike], 8) == [whole]
+
+
 def test_landmarks_side_by_side_or_one_on_its_robot_are_not_one():
     a = cand(10, w=20)
     assert merge_candidates([a], [cand(31, w=20)], 8) == [a, cand(31, w=20)]  # the next one along
