@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rangebearing.core.fragments import extend_along_bands, height_steps, join_fragments, lit_like_bands
+from rangebearing.core.fragments import extend_along_bands, height_steps, join_fragments, lit_like_bands, split_runs
 
 WIDTH_K, BAND_K = 35 / 40, 15 / 40
 
@@ -26,6 +26,17 @@ def test_no_split_when_the_taller_piece_would_not_be_a_whole_silhouette():
     e1 = np.array([12.0] * 30 + [10.0] * 10)  # the taller part is 10 of its 19 columns: not in front
     e2 = np.array([31.0] * 30 + [33.0] * 10)
     assert height_steps(e1, e2, WIDTH_K) == [(0, 40)]
+
+
+def test_a_too_wide_run_whose_band_merged_with_a_wall_is_split_where_both_edges_step_too():
+    # two landmarks side by side before a red wall: their red bands run up into it, their inner edges step
+    e1 = np.array([12.0] * 10 + [11, 10] + [10.0] * 21)
+    e2 = np.array([31.0] * 10 + [32, 33] + [33.0] * 21)
+    run_r, run_b = np.full(33, 40.0), np.full(33, 7.0)  # red runs on for 40 rows: merged
+    pieces = split_runs([(0, 33)], e1, e2, run_r, run_b, BAND_K, WIDTH_K, 1.7)
+    assert pieces == [(0, 11), (11, 33)] or pieces == [(0, 12), (12, 33)]
+    flat = np.full(33, 12.0), np.full(33, 33.0)  # one height: one structure (no landmark), kept whole
+    assert split_runs([(0, 33)], *flat, run_r, run_b, BAND_K, WIDTH_K, 1.7) == [(0, 33)]
 
 
 def masks(h=80, w=80):

@@ -97,8 +97,7 @@ def split_runs(
         return list(found)
     out: List[Tuple[int, int]] = []
     for (r0, r1), look in zip(found, wide.tolist()):
-        hb = band_k * float(median(g[r0:r1])) if look else 0.0
-        if not look or max(float(median(run_r[r0:r1])), float(median(run_b[r0:r1]))) > merged_k * hb + 1:
+        if not look:
             out.append((r0, r1))
             continue
         out.extend((r0 + a, r0 + b) for a, b in height_steps(e1[r0:r1], e2[r0:r1], width_k))
