@@ -25,13 +25,13 @@ All coordinates here are in the downscaled masks' pixels until
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .._compat import frozen
+from .behind import occluded_sides, without_nearer
 from .color import RELAXED_WHITE_V
 from .columns import WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .denoise import both_outside
@@ -223,7 +223,9 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
         blue_merged = med_b > MERGED * hb + 1
         seen, hidden, ext_l, ext_r = 1.0, "", False, False
         if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):  # a body hidden, bands whole
-            c0f, c1f, seen, hidden, ext_l, ext_r = extend_along_bands(frag, red, blue, band_k, width_k)
+            # its bands end where a nearer landmark found already hides them (core/behind.py)
+            r_m, b_m = without_nearer(red, blue, out, scale)
+            c0f, c1f, seen, hidden, ext_l, ext_r = extend_along_bands(frag, r_m, b_m, band_k, width_k)
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0
         ratio = n / w_exp
@@ -258,30 +260,6 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
             if len(out) >= max_landmarks:
                 return occluded_sides(out, scale)
     return occluded_sides(out, scale)
-
-
-def occluded_sides(cands: List[Candidate], scale: int) -> List[Candidate]:
-    """Mark the side of a narrower-than-whole candidate where a nearer landmark (larger white body)
-    stands right beside it: that landmark hides it there, so that side is no limb."""
-    out = []
-    for c in cands:
-        x0, x1 = c.red_bbox_px[0], c.red_bbox_px[0] + c.red_bbox_px[2]
-        near_l = near_r = False
-        if c.visible < 0.9:
-            for o in cands:
-                if o.white_px <= c.white_px:
-                    continue
-                ox0, ox1 = o.red_bbox_px[0], o.red_bbox_px[0] + o.red_bbox_px[2]
-                near_l = near_l or abs(ox1 - x0) <= 2 * scale
-                near_r = near_r or abs(ox0 - x1) <= 2 * scale
-        left, right = (near_l, near_r) if not (c.cut_left or c.cut_right) else (c.cut_left, c.cut_right)
-        # the side a nearer landmark hides, even where the run's other end was marked cut too (its band runs on
-        # into a same-coloured wall): that end may still be a limb (.limbs.measure_columns)
-        occluded = "left" if near_l and not near_r else "right" if near_r and not near_l else ""
-        if (left, right, occluded) != (c.cut_left, c.cut_right, c.occluded):
-            c = dataclasses.replace(c, cut_left=left, cut_right=right, occluded=occluded)
-        out.append(c)
-    return out
 
 
 def _overlaps(a: BBox, b: BBox) -> bool:
