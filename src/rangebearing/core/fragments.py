@@ -79,9 +79,11 @@ def split_runs(
 ) -> List[Tuple[int, int]]:
     """The runs ``found`` (``[start, stop)`` over per-column edges and band runs) cut by :func:`height_steps`.
 
-    A run whose band runs on past ``merged_k`` band heights (plus one) is merged with a same-coloured
-    background and kept whole, as a wide run with a merged band is never split at one range either.
-    Only runs wider than ``WIDE`` silhouettes of their tallest column are looked at (few are).
+    A run whose band merged with a same-coloured background (runs on past ``merged_k`` band heights)
+    is split as any other: the steps are in its inner edges, which stay sharp (two landmarks side by
+    side before a red wall); the band runs ``run_r``/``run_b`` and ``band_k``/``merged_k`` are the
+    column scan's call (:func:`.columns.window_runs`) and decide nothing here. Only runs wider than
+    ``WIDE`` silhouettes of their tallest column are looked at (few are).
     """
     if not found:
         return []
