@@ -231,9 +231,14 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
         ratio = n / w_exp
         k = round(ratio)
         if ratio > 1 + SPLIT_TOL:
-            if k < 2 or abs(ratio - k) > SPLIT_TOL or red_merged or blue_merged:
+            if red_merged or blue_merged:
                 continue
-            pieces = [(s0 + n * q / k, s0 + n * (q + 1) / k) for q in range(k)]
+            if 1 + MIN_VISIBLE <= ratio < 2 - SPLIT_TOL:  # one whole in front of another shown in part: a
+                pieces = [(float(s0), s0 + w_exp), (s1 - w_exp, float(s1))]  # silhouette from each end's limb
+            elif k < 2 or abs(ratio - k) > SPLIT_TOL:
+                continue
+            else:
+                pieces = [(s0 + n * q / k, s0 + n * (q + 1) / k) for q in range(k)]
         elif ratio < MIN_VISIBLE or n < 2:
             continue
         else:
