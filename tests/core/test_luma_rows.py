@@ -13,28 +13,42 @@ from rangebearing.synth.isp import chroma_denoise, sharpen, subsample_chroma
 GEOMETRY = LandmarkGeometry()
 
 
+def _landmark(bg, r0, scale=1.0, dark_rows=0.0, dark=0.05):
+    """A landmark ``scale`` × (15, 40, 15) px tall from row ``r0`` on a grey ``bg`` (linear, 8× supersampled
+    rows), with a dark part (``dark``, linear) across the white body's top ``dark_rows`` rows. Returns the
+    120 × 80 px linear image, columns 20-59 the landmark, and the blue band's top row."""
+    ss, rows = 8, 120
+    y = (np.arange(rows * ss) + 0.5) / ss
+    r1, b0, b1 = r0 + 15 * scale, r0 + 55 * scale, r0 + 70 * scale
+    lin = np.full((rows * ss, 3), bg)
+    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
+    lin[(y >= r1) & (y < b0)] = 0.85
+    lin[(y >= r1) & (y < r1 + dark_rows)] = dark
+    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
+    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
+    img[:, :20] = img[:, 60:] = bg
+    return img, b0
+
+
+def _isp(img, denoise_px):
+    """A linear image blurred by the lens (1 px, linear light), then through the ISP: luma sharpening,
+    colour denoise (``denoise_px``) and 4:2:0 chroma."""
+    img = cv2.GaussianBlur(img, (0, 0), 1.0)
+    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
+    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    return subsample_chroma(chroma_denoise(bgr, denoise_px))
+
+
 def _camera(bg, offset_px, scale):
     """A landmark ``scale`` × (15, 40, 15) px tall on a grey ``bg`` (linear), its edges ``offset_px``
     below whole rows, blurred by the lens (1 px, linear light), then through the ISP: luma
     sharpening, colour denoise (1.5 px) and 4:2:0 chroma. Returns the frame, the candidate and
     the true band spacing L (rows)."""
-    ss, rows = 8, 120
-    y = (np.arange(rows * ss) + 0.5) / ss
-    r0 = 20 + offset_px
-    r1, b0, b1 = r0 + 15 * scale, r0 + 55 * scale, r0 + 70 * scale
-    lin = np.full((rows * ss, 3), bg)
-    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
-    lin[(y >= r1) & (y < b0)] = 0.85
-    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
-    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
-    img[:, :20] = img[:, 60:] = bg
-    img = cv2.GaussianBlur(img, (0, 0), 1.0)
-    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
-    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    img, _ = _landmark(bg, 20 + offset_px, scale)
     band = round(15 * scale)
     cand = Candidate((20, 20, 40, band), (20, round(20 + 55 * scale), 40, band), 40.0 * scale,
                      False, False, False, False, 1.0)
-    return subsample_chroma(chroma_denoise(bgr, 1.5)), cand, 55 * scale
+    return _isp(img, 1.5), cand, 55 * scale
 
 
 @pytest.mark.parametrize("scale", [1.0, 0.4])
@@ -105,22 +119,9 @@ def test_a_luma_edge_far_from_the_chroma_one_is_not_taken():
 def _dark_below_red(rows_dark, part=0.05):
     """:func:`_camera`'s landmark (scale 1, grey 0.3, 1.5 px colour denoise) with a dark part in front
     of the white body's top ``rows_dark`` rows, right below the red band (a nearer robot's board)."""
-    ss, rows = 8, 120
-    y = (np.arange(rows * ss) + 0.5) / ss
-    r0 = 20.3
-    r1, b0, b1 = r0 + 15, r0 + 55, r0 + 70
-    lin = np.full((rows * ss, 3), 0.3)
-    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
-    lin[(y >= r1) & (y < b0)] = 0.85
-    lin[(y >= r1) & (y < r1 + rows_dark)] = part
-    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
-    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
-    img[:, :20] = img[:, 60:] = 0.3
-    img = cv2.GaussianBlur(img, (0, 0), 1.0)
-    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
-    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
+    img, _ = _landmark(0.3, 20.3, dark_rows=rows_dark, dark=part)
     cand = Candidate((20, 20, 40, 15), (20, 75, 40, 15), 40.0, False, False, False, False, 1.0)
-    return subsample_chroma(chroma_denoise(bgr, 1.5)), cand
+    return _isp(img, 1.5), cand
 
 
 @pytest.mark.parametrize("rows_dark", [2.0, 3.0])
@@ -165,22 +166,10 @@ def test_an_unsharpened_luma_edge_stays_the_two_level_integral():
 def _hidden_blue(denoise_px, hide_from_px=8.0, front=0.55):
     """:func:`_camera`'s landmark (scale 1, grey 0.3) with a nearer robot's pale body hiding the blue band
     below ``hide_from_px`` of it, through a colour denoise of ``denoise_px``."""
-    ss, rows = 8, 120
-    y = (np.arange(rows * ss) + 0.5) / ss
-    r0 = 20.3
-    r1, b0, b1 = r0 + 15, r0 + 55, r0 + 70
-    lin = np.full((rows * ss, 3), 0.3)
-    lin[(y >= r0) & (y < r1)] = (0.70, 0.07, 0.06)
-    lin[(y >= r1) & (y < b0)] = 0.85
-    lin[(y >= b0) & (y < b1)] = (0.06, 0.12, 0.65)
-    img = np.repeat(lin.reshape(rows, ss, 3).mean(axis=1)[:, None], 80, axis=1).astype(np.float32)
-    img[:, :20] = img[:, 60:] = 0.3
+    img, b0 = _landmark(0.3, 20.3)
     img[int(b0 + hide_from_px) + 1 :, :] = front
-    img = cv2.GaussianBlur(img, (0, 0), 1.0)
-    bgr = np.round(255 * np.clip(img[..., ::-1], 0, 1) ** (1 / 2.2)).astype(np.uint8)
-    bgr = cv2.cvtColor(sharpen(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB), 1.0), cv2.COLOR_RGB2BGR)
     cand = Candidate((20, 20, 40, 15), (20, 75, 40, 15), 40.0, False, False, False, False, 1.0)
-    return subsample_chroma(chroma_denoise(bgr, denoise_px)), cand
+    return _isp(img, denoise_px), cand
 
 
 def test_a_partly_hidden_blue_band_is_known_from_the_luma_when_chroma_bled_the_white_body_short():
