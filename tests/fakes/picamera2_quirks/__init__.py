@@ -101,13 +101,19 @@ def reset() -> None:
     SCENE, NONE_EVERY = _default_scene, 3
 
 
-def _rgb_to_yuv420(rgb: np.ndarray, stride: int) -> np.ndarray:
-    """SMPTE 170M limited-range I420, (H·3/2, stride) with the chroma rows stride/2 (picamera2's layout)."""
-    h, w = rgb.shape[:2]
+def _ycbcr_levels(rgb: np.ndarray) -> tuple:
+    """SMPTE 170M limited-range Y, Cb, Cr of an RGB image, unrounded (float64, full resolution)."""
     r, g, b = (rgb[..., i].astype(np.float64) for i in range(3))
     y = 16 + (65.481 * r + 128.553 * g + 24.966 * b) / 255
     u = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255
     v = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255
+    return y, u, v
+
+
+def _rgb_to_yuv420(rgb: np.ndarray, stride: int) -> np.ndarray:
+    """SMPTE 170M limited-range I420, (H·3/2, stride) with the chroma rows stride/2 (picamera2's layout)."""
+    h, w = rgb.shape[:2]
+    y, u, v = _ycbcr_levels(rgb)
     out = np.zeros((h * 3 // 2, stride), np.uint8)
     out[:h, :w] = np.clip(np.rint(y), 0, 255)
     chroma = out[h:].reshape(2, h // 2, stride // 2)
@@ -125,11 +131,7 @@ ALIGN = {"XBGR8888": 16, "RGB161616": 16, "YUV420": 64}  # align_stream on VC4 (
 
 
 def _rgb_to_ycbcr(rgb: np.ndarray) -> tuple:
-    r, g, b = (rgb[..., i].astype(np.float64) for i in range(3))
-    y = 16 + (65.481 * r + 128.553 * g + 24.966 * b) / 255
-    u = 128 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255
-    v = 128 + (112.0 * r - 93.786 * g - 18.214 * b) / 255
-    return tuple(np.clip(np.rint(c), 0, 255).astype(np.uint8) for c in (y, u, v))
+    return tuple(np.clip(np.rint(c), 0, 255).astype(np.uint8) for c in _ycbcr_levels(rgb))
 
 
 def _main_buffer(rgb: np.ndarray, fmt: str, stride: int) -> np.ndarray:
