@@ -3,18 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+from tests.core.test_newcomers import BLUE, RED, UNIT, frame, late_frames
 
-from rangebearing import Pipeline, load_config
 from rangebearing.core.newcomers import BESIDE_GAP_PX, beside_count
 from rangebearing.core.params import DetectionParams
-from rangebearing.synth import Imaging, LandmarkPose, Scene, render
-
-RED, BLUE, GREY = (40, 40, 200), (200, 60, 40), (128, 128, 128)  # BGR
-UNIT = (1.0, 1.0, 1.0)
-
-
-def frame(w: int = 160, h: int = 120) -> np.ndarray:
-    return np.full((h, w, 3), GREY, np.uint8)
+from rangebearing.synth import LandmarkPose
 
 
 def paint_landmark(img: np.ndarray, x0: int, x1: int) -> None:
@@ -57,17 +50,7 @@ def test_another_followed_landmark_beside_it_is_not_counted():
 def test_a_landmark_uncovered_by_a_nearer_one_driving_off_is_found_as_soon_as_a_full_scan_finds_it():
     # a near landmark drives sideways off a farther one standing behind it: the tracker follows the near one in
     # its window, and nothing comes in at the frame's sides
-    rng = np.random.default_rng(7)
-    noise = Imaging(blur_sigma_px=0.5, read_noise=0.004, shot_noise=0.0005)
-    frames = [render(Scene(landmarks=(LandmarkPose(0.6, 0.02 + 0.004 * i), LandmarkPose(1.2, 0.0)),
-                           wall_distance_m=2.5, imaging=noise), rng) for i in range(24)]
-    cfg = load_config(None)
-    full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
-    late = 0
-    for k, img in enumerate(frames):
-        a, b = full.process(img), tracker.process(img)
-        if k > 0 and len(b.landmarks) < len(a.landmarks):
-            late += 1
-    assert len(a.landmarks) == 2  # it did come out
+    late, last = late_frames(lambda i: (LandmarkPose(0.6, 0.02 + 0.004 * i), LandmarkPose(1.2, 0.0)), 24, seed=7)
+    assert len(last.landmarks) == 2  # it did come out
     # a full scan every 8 frames alone would leave it unreported for several frames after it came out
     assert late <= 1

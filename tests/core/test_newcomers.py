@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any, Callable, Tuple
+
 import numpy as np
 
 from rangebearing import Pipeline, load_config
@@ -56,19 +58,25 @@ def test_the_strips_are_the_frame_sides_only():
     assert side_colour(img, DetectionParams(), UNIT, []) == (0, 0)
 
 
-def test_a_landmark_driving_in_at_the_side_is_found_as_soon_as_a_full_scan_finds_it():
-    # a still landmark in the middle keeps the tracker in window mode; a second one comes in from the left edge
-    rng = np.random.default_rng(5)
+def late_frames(poses: Callable[[int], Tuple[LandmarkPose, ...]], n: int, seed: int) -> Tuple[int, Any]:
+    """Frames (after the first) in which a tracker reports fewer landmarks than a full scan, over ``n`` noisy
+    renders of ``poses(i)`` before a wall 2.5 m away; and the last frame's full-scan result."""
+    rng = np.random.default_rng(seed)
     noise = Imaging(blur_sigma_px=0.5, read_noise=0.004, shot_noise=0.0005)
-    frames = [render(Scene(landmarks=(LandmarkPose(0.8, -0.1), LandmarkPose(1.0, 0.50 - 0.006 * i)),
-                           wall_distance_m=2.5, imaging=noise), rng) for i in range(16)]
     cfg = load_config(None)
     full, tracker = Pipeline(cfg.pipeline, track=False), Pipeline(cfg.pipeline, track=True)
-    late = 0
-    for k, img in enumerate(frames):
+    late, a = 0, None
+    for k in range(n):
+        img = render(Scene(landmarks=poses(k), wall_distance_m=2.5, imaging=noise), rng)
         a, b = full.process(img), tracker.process(img)
         if k > 0 and len(b.landmarks) < len(a.landmarks):
             late += 1
+    return late, a
+
+
+def test_a_landmark_driving_in_at_the_side_is_found_as_soon_as_a_full_scan_finds_it():
+    # a still landmark in the middle keeps the tracker in window mode; a second one comes in from the left edge
+    late, _ = late_frames(lambda i: (LandmarkPose(0.8, -0.1), LandmarkPose(1.0, 0.50 - 0.006 * i)), 16, seed=5)
     # a full scan every 8 frames alone would leave it unreported for several frames after it came in
     assert late <= 1
 
