@@ -54,13 +54,13 @@ def test_thresholds_from_the_page_change_the_readings(static_clip: Path) -> None
             assert set(state["stats"]["stage_ms"]) == {"wait", "process", "send"}
             hub.set_thresholds(dataclasses.replace(hub.thresholds, s_min=255))
             for _ in range(100):
-                snap = hub.wait(snap.seq, 5.0)
+                snap = hub.wait(snap.seq, 10.0)
                 assert snap is not None
                 if json.loads(snap.state)["thresholds"]["s_min"] == 255:
                     break
             n = len(pub.payloads)
             for _ in range(100):  # the hub's thread may still turn an offer sent before n into the next snapshot
-                snap = hub.wait(snap.seq, 5.0)
+                snap = hub.wait(snap.seq, 10.0)
                 assert snap is not None
                 if len(pub.payloads) > n:
                     break
