@@ -133,6 +133,7 @@ def test_stop_from_another_thread_ends_a_paced_source_promptly(static_clip):
 
 
 def picamera_cfg(**source) -> Config:
+    """A fake camera config; tests that wait for frames ask ``retries=50`` (10 s: each frame is rendered)."""
     fields = {"kind": "picamera2", "fps": 30.0, "timeout_s": 0.2, "retries": 3, **source}
     src = dataclasses.replace(SourceConfig(), **fields)
     return dataclasses.replace(Config(), source=src)
@@ -147,7 +148,7 @@ def test_picamera2_source_runs_through_the_loop_and_survives_a_capture_timeout(f
     world = fake_picamera2.WORLD
     world.producer = static_rgb
     seen: List[bytes] = []
-    daemon = Daemon(picamera_cfg(retries=10), opener, lambda c: MemoryPublisher(), RecordingNotifier())
+    daemon = Daemon(picamera_cfg(retries=50), opener, lambda c: MemoryPublisher(), RecordingNotifier())
 
     def echo(payload: bytes) -> None:
         seen.append(payload)
@@ -262,7 +263,7 @@ def test_a_paced_recording_stays_paced_after_the_open_budget(static_clip):
 
 def test_recorded_frames_are_read_in_the_loop_thread_camera_frames_in_a_reader(static_clip, fake_picamera2):
     names = {}
-    for key, cfg in (("recorded", recorded_cfg(static_clip)), ("camera", picamera_cfg())):
+    for key, cfg in (("recorded", recorded_cfg(static_clip)), ("camera", picamera_cfg(retries=50))):
         if key == "camera":
             fake_picamera2.WORLD.producer = static_rgb
         daemon = Daemon(cfg, opener, lambda c: MemoryPublisher(), RecordingNotifier())
@@ -284,7 +285,7 @@ def test_frames_borrowed_from_the_camera_are_copied_for_the_recorder(fake_picame
         def close(self):
             pass
 
-    daemon = Daemon(picamera_cfg(), lambda cfg, sleep: open_source(cfg.source, cfg.camera, sleep=sleep,
+    daemon = Daemon(picamera_cfg(retries=50), lambda cfg, sleep: open_source(cfg.source, cfg.camera, sleep=sleep,
                                                                    in_place=True),
                     lambda c: MemoryPublisher(), RecordingNotifier(), recorder=Keeper())
     daemon.echo = lambda p: len(kept) >= 3 and daemon.stop()
