@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
-from rangebearing.core.detect import downscale
+from rangebearing.core.detect import _clipped, downscale
 from rangebearing.core.params import DetectionParams
 from rangebearing.core.yuv import (
     BLUE,
@@ -172,3 +172,49 @@ def test_masks_and_gains_match_the_bgr_path_on_a_rendered_frame():
         assert n > 100 and abs(np.count_nonzero(got) - n) <= 0.1 * n
         edge = cv2.dilate(ref, kernel) != cv2.erode(ref, kernel)
         assert not np.any((got != ref) & ~edge)  # they differ only on the bands' outlines
+
+
+def _bgr_path_masks(small, gains):
+    """The BGR path's unfiltered masks with its clipped rules (pixels clipped before the gains included)."""
+    return class_masks(to_hsv(apply_gains(small, gains)), DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min,
+                       _clipped(small, gains))
+
+
+def test_clipped_colours_of_a_grid_classify_as_the_bgr_path_does():
+    # every (B, G, R) on a 16-level grid with its strongest channel clipped (255): over-exposed bands read
+    # orange/magenta or cyan/violet and paler than the paint; the BGR path widens their hues and halves S's floor
+    levels = np.arange(15, 256, 16, dtype=np.uint8)
+    grid = np.stack(np.meshgrid(levels, levels, levels, indexing="ij"), -1).reshape(-1, 3)
+    grid = grid[grid.max(1) == 255].reshape(1, -1, 3)
+    bgr = np.repeat(np.repeat(grid, 2, 0), 2, 1)
+    ref = _bgr_path_masks(np.ascontiguousarray(bgr[::2, ::2]), (1.0, 1.0, 1.0))
+    got = chroma_masks(yuv420_from_bgr(bgr), DET)
+    for g, r in zip(got, ref):
+        assert np.count_nonzero(r) > 20
+        # 8-bit Y'CbCr rounding moves a colour lying on a threshold (S = 80, hue 83) across it
+        assert np.count_nonzero(g != r) <= 0.02 * np.count_nonzero(r)
+
+
+@pytest.mark.parametrize("bgr", [(150, 160, 252), (252, 200, 170)])
+def test_a_band_clipped_before_a_gain_below_one_stays_clipped(bgr):
+    # a gain of 0.85 on the clipped channel takes it under 250: the pixel is still clipped (color.clipped_mask),
+    # so S >= s_min / 2 suffices on both paths
+    gains = (0.85, 1.0, 1.0) if bgr[0] > 250 else (1.0, 1.0, 0.85)
+    ref = _bgr_path_masks(patch(bgr, 2), gains)
+    got = chroma_masks(yuv420_from_bgr(patch(bgr)), DET, gains)
+    assert np.array_equal(got[0], ref[0]) and np.array_equal(got[1], ref[1])
+    assert (ref[0] if bgr[2] > 250 else ref[1]).all()
+
+
+def test_masks_match_the_bgr_path_on_an_over_exposed_frame():
+    # two stops over: every band's strongest channel clips; the masks agree pixel for pixel but for rounding
+    scene = Scene(landmarks=(LandmarkPose(0.5, 0.15), LandmarkPose(1.1, -0.2)), wall_distance_m=1.8,
+                  lighting=Lighting(exposure=4.0))
+    bgr = render(scene, np.random.default_rng(3))
+    small = downscale(bgr, 2)
+    assert np.count_nonzero(small.max(2) >= 250) > 0.5 * small.shape[0] * small.shape[1]
+    gains = grey_world_gains(small)
+    planes = yuv420_from_bgr(bgr)
+    for got, ref in zip(chroma_masks(planes, DET, yuv_grey_world_gains(planes)), _bgr_path_masks(small, gains)):
+        assert np.count_nonzero(ref) > 200
+        assert np.count_nonzero(got != ref) <= 2

@@ -22,7 +22,6 @@ lookup when they are not within 2 % of one.
 from __future__ import annotations
 
 import dataclasses
-import functools
 from typing import Optional, Sequence, Tuple
 
 import cv2
@@ -35,18 +34,11 @@ from .denoise import Box, band_masks, none_apart_filtered
 from .params import DetectionParams
 from .structure import Found, search, search_apart
 from .types import LandmarkGeometry
+from .yuv_table import BLUE, COLOUR_SPACES, NONE, RED, _rgb_matrix, class_table, clipped_table
 
-# Y'CbCr → R'G'B' (8 bit): R = a·(Y − y0) + rv·(V − 128); G = a·(Y − y0) + gu·(U − 128) + gv·(V − 128);
-# B = a·(Y − y0) + bu·(U − 128). SMPTE 170M is BT.601 limited range: libcamera's default for
-# video below 1280×720, and what OpenCV's COLOR_BGR2YUV_I420 produces.
-COLOUR_SPACES = {
-    "smpte170m": (255 / 219, 16.0, 255 / 224 * 1.402, -255 / 224 * 1.772 * 0.114 / 0.587,
-                  -255 / 224 * 1.402 * 0.299 / 0.587, 255 / 224 * 1.772),
-    "sycc": (1.0, 0.0, 1.402, -1.772 * 0.114 / 0.587, -1.402 * 0.299 / 0.587, 1.772),
-    "rec709": (255 / 219, 16.0, 255 / 224 * 1.5748, -255 / 224 * 1.8556 * 0.0722 / 0.7152,
-               -255 / 224 * 1.5748 * 0.2126 / 0.7152, 255 / 224 * 1.8556),
-}
-NONE, RED, BLUE = 0, 1, 2
+__all__ = ["BLUE", "COLOUR_SPACES", "NONE", "RED", "Yuv420", "chroma_masks", "class_table", "half_luma",
+           "yuv420_from_bgr", "yuv420_planes", "yuv_grey_world_gains", "yuv_search", "yuv_to_bgr"]
+
 # B'G'R' → Cb, Cr (8 bit, limited range), rows U, V with a constant column: OpenCV's I420 coefficients
 _FORWARD = {"smpte170m": np.array([[0.439, -0.291, -0.148, 128.0], [-0.071, -0.368, 0.439, 128.0]])}
 
@@ -111,13 +103,6 @@ def yuv420_planes(buffer: np.ndarray, width_px: int, height_px: int, colour_spac
     return Yuv420(y, planes[0, :, : w // 2], planes[1, :, : w // 2], colour_space)
 
 
-def _rgb_matrix(colour_space: str) -> Tuple[np.ndarray, np.ndarray]:
-    """(3×3 M, 3 offset) with [R, G, B] = M · [Y, U, V] + offset."""
-    a, y0, rv, gu, gv, bu = COLOUR_SPACES[colour_space]
-    m = np.array([[a, 0.0, rv], [a, gu, gv], [a, bu, 0.0]])
-    return m, -m @ np.array([y0, 128.0, 128.0])
-
-
 def _bgr_affine(colour_space: str, gains: Gains = UNIT_GAINS) -> np.ndarray:
     """3×4 matrix taking [Y, U, V, 1] to the balanced [B, G, R] (``gains`` are b, g, r)."""
     m, off = _rgb_matrix(colour_space)
@@ -146,43 +131,6 @@ def yuv_grey_world_gains(yuv: Yuv420, limit: float = 2.0, y_half: Optional[np.nd
     return grey_world_gains(yuv_to_bgr(y, u, v, yuv.colour_space), limit)
 
 
-@functools.lru_cache(maxsize=8)
-def class_table(colour_space: str, red_hue: tuple, blue_hue: tuple, s_min: int, v_min: int) -> np.ndarray:
-    """(65536,) uint32 table indexed by ``U << 8 | V``: ylo | yhi << 8 | class << 16.
-
-    A pixel is of ``class`` (RED, BLUE; NONE is 0) when ``ylo ≤ Y ≤ yhi``;
-    hue follows OpenCV's 8-bit convention (0–179), S and V are 0–255 and
-    rounded as OpenCV rounds them.
-    """
-    a, y0 = COLOUR_SPACES[colour_space][:2]
-    m, _ = _rgb_matrix(colour_space)
-    du = (np.arange(256.0) - 128.0)[:, None]  # U down the rows, V along them: the index U << 8 | V
-    dv = (np.arange(256.0) - 128.0)[None, :]
-    # R, G, B minus a(Y - y0), as planes (built on the daemon's first frame: no (256, 256, 3) stack and
-    # axis reductions, ~3x cheaper; the same values)
-    r, g, b = (m[k, 1] * du + m[k, 2] * dv for k in range(3))
-    bgr = cv2.merge([(p + 256.0).astype(np.float32) for p in (b, g, r)])  # hue does not change with a common offset
-    hue = cv2.cvtColor(bgr, cv2.COLOR_BGR2HSV)[..., 0]
-    hue8 = np.round(hue / 2.0).astype(np.int64) % 180
-    top = np.maximum(np.maximum(r, g), b)
-    chroma = top - np.minimum(np.minimum(r, g), b)
-    cls = np.zeros((256, 256), np.uint32)
-    for label, ranges in ((RED, red_hue), (BLUE, blue_hue)):
-        inside = np.zeros((256, 256), bool)
-        for lo, hi in ranges:
-            inside |= (hue8 >= lo) & (hue8 <= hi)
-        cls[inside & (chroma > 0)] = label
-    # V = a(Y - y0) + top ≥ v_min - 0.5 ; S = 255·C / V ≥ s_min - 0.5  (8-bit rounding)
-    ylo = np.ceil(y0 + (v_min - 0.5 - top) / a)
-    with np.errstate(divide="ignore"):
-        vmax = 255.0 * chroma / max(s_min - 0.5, 1e-6)
-    yhi = np.floor(y0 + (vmax - top) / a)
-    empty = (ylo > yhi) | (ylo > 255) | (yhi < 0) | (cls == NONE)
-    ylo = np.where(empty, 255, np.clip(ylo, 0, 255)).astype(np.uint32)  # 255 ≤ Y ≤ 0: no pixel
-    yhi = np.where(empty, 0, np.clip(yhi, 0, 255)).astype(np.uint32)
-    return (ylo | (yhi << 8) | (cls << 16)).reshape(-1)
-
-
 def _balance(y: np.ndarray, u: np.ndarray, v: np.ndarray, gains: Gains, colour_space: str):
     """Planes of the balanced image: the gains on R, G, B as one affine map of (Y, U, V)."""
     m, off = _rgb_matrix(colour_space)
@@ -205,23 +153,46 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
     """Red and blue masks (0/255 uint8, half resolution) of a YUV420 image, before the majority filter.
 
     The same masks :func:`~rangebearing.core.color.class_masks` makes from the
-    balanced, downscaled BGR frame, up to rounding and channel clipping.
+    balanced, downscaled BGR frame (its clipped pixels' rules included, with the
+    mask of pixels clipped before the gains), up to rounding and channel
+    clipping.
     ``y_half`` is :func:`half_luma` of ``yuv.y`` when the caller has it.
     """
     y, u, v = half_luma(yuv.y) if y_half is None else y_half, yuv.u, yuv.v
+    raw = None  # the unbalanced (U, V) index and Y, when a gain below one may hide a clipped channel
+    if min(gains) < 0.98:
+        raw = (_uv_index(u, v), y)
     if not all(abs(g - 1.0) <= 0.02 for g in gains):
         y, u, v = _balance(y, np.ascontiguousarray(u), np.ascontiguousarray(v), gains, yuv.colour_space)
-    table = class_table(yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)),
-                        int(cfg.s_min), int(cfg.v_min))
-    idx = u.astype(np.uint16)
-    idx <<= 8
-    idx |= v
-    packed = table.take(idx).view(np.uint8).reshape(*idx.shape, 4)
-    ylo, yhi, cls, _ = cv2.split(packed)
+    keys = (yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)), int(cfg.s_min))
+    idx = _uv_index(u, v)
+    ylo, yhi, cls, _ = _lookup(class_table(*keys, int(cfg.v_min)), idx)
     ok = cv2.bitwise_and(cv2.compare(y, ylo, cv2.CMP_GE), cv2.compare(y, yhi, cv2.CMP_LE))
     red = cv2.bitwise_and(cv2.compare(cls, RED, cv2.CMP_EQ), ok)
     blue = cv2.bitwise_and(cv2.compare(cls, BLUE, cv2.CMP_EQ), ok)
+    # the clipped pixels' rules (:func:`.yuv_table.clipped_table`): V clipped after the gains, or before them
+    table = clipped_table(*keys)
+    yclip, yhi, cls, _ = _lookup(table, idx)
+    clip = cv2.compare(y, yclip, cv2.CMP_GE)
+    if raw is not None:
+        clip = cv2.bitwise_or(clip, cv2.compare(raw[1], _lookup(table, raw[0])[3], cv2.CMP_GE))
+    ok = cv2.bitwise_and(clip, cv2.compare(y, yhi, cv2.CMP_LE))
+    red = cv2.bitwise_or(red, cv2.bitwise_and(cv2.compare(cls, RED, cv2.CMP_EQ), ok))
+    blue = cv2.bitwise_or(blue, cv2.bitwise_and(cv2.compare(cls, BLUE, cv2.CMP_EQ), ok))
     return red, blue
+
+
+def _uv_index(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """uint16 ``U << 8 | V`` of two uint8 planes: the tables' index."""
+    idx = u.astype(np.uint16)
+    idx <<= 8
+    idx |= v
+    return idx
+
+
+def _lookup(table: np.ndarray, idx: np.ndarray) -> Tuple[np.ndarray, ...]:
+    """The four uint8 bytes (low first) of a packed uint32 table at each index, as planes."""
+    return tuple(cv2.split(table.take(idx).view(np.uint8).reshape(*idx.shape, 4)))
 
 
 class WindowHsv:
