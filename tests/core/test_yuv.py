@@ -218,3 +218,26 @@ def test_masks_match_the_bgr_path_on_an_over_exposed_frame():
     for got, ref in zip(chroma_masks(planes, DET, yuv_grey_world_gains(planes)), _bgr_path_masks(small, gains)):
         assert np.count_nonzero(ref) > 200
         assert np.count_nonzero(got != ref) <= 2
+
+
+def test_a_gain_above_one_saturates_a_clipped_white_as_on_the_bgr_path():
+    # clipped white under gains (1.15, 1.0, 0.87): the BGR path's blue saturates at 255, (255, 255, 222) reads
+    # cyan and pale (S 33); unsaturated, the same (Y, U, V) would read blue at S 60, clipped, S >= s_min / 2
+    gains = (1.15, 1.0, 0.87)
+    ref = _bgr_path_masks(patch((255, 255, 255), 2), gains)
+    got = chroma_masks(yuv420_from_bgr(patch((255, 255, 255))), DET, gains)
+    assert not ref[1].any() and not got[1].any() and not got[0].any()
+
+
+@pytest.mark.parametrize("exposure, wb", [(3.0, (1.3, 1.0, 0.8)), (3.5, (0.8, 1.0, 1.3))])
+def test_masks_match_the_bgr_path_on_an_over_exposed_tinted_frame(exposure, wb):
+    scene = Scene(landmarks=(LandmarkPose(0.5, 0.15), LandmarkPose(1.1, -0.2)), wall_distance_m=1.8,
+                  lighting=Lighting(exposure=exposure, wb_gains=wb))
+    bgr = render(scene, np.random.default_rng(3))
+    small = downscale(bgr, 2)
+    gains = grey_world_gains(small)
+    assert max(gains) > 1.05 and min(gains) < 0.95  # a gain each way: saturated and hidden clipped channels
+    planes = yuv420_from_bgr(bgr)
+    for got, ref in zip(chroma_masks(planes, DET, yuv_grey_world_gains(planes)), _bgr_path_masks(small, gains)):
+        assert np.count_nonzero(ref) > 200
+        assert np.count_nonzero(got != ref) <= 0.01 * np.count_nonzero(ref)  # 8-bit rounding on the outlines

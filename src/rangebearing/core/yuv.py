@@ -13,10 +13,12 @@ Why a table on (U, V) is exact: RGB = a·(Y − y0) + d(U, V), the same ``a·(Y 
 added to every channel, so the channel differences (hence HSV hue) depend on
 U and V alone, as does the chroma C = max − min. Saturation C / max and value
 max = a·(Y − y0) + max(d) turn into bounds on Y: ``V ≥ v_min`` is
-``Y ≥ ylo(U, V)`` and ``S ≥ s_min`` is ``Y ≤ yhi(U, V)``. Only channel
-clipping at 0 and 255 is not modelled. Grey-world gains (a diagonal gain on
-R, G, B) are an affine map of (Y, U, V), applied to the planes before the
-lookup when they are not within 2 % of one.
+``Y ≥ ylo(U, V)`` and ``S ≥ s_min`` is ``Y ≤ yhi(U, V)``; the BGR path's rules
+for clipped pixels (V ≥ 250) are a second table (:mod:`.yuv_table`). Grey-world
+gains (a diagonal gain on R, G, B) are an affine map of (Y, U, V), applied to
+the planes before the lookup when they are not within 2 % of one; the few
+pixels a gain above one would saturate at 255 are classed from their BGR.
+Channel clipping at 0 is not modelled.
 """
 
 from __future__ import annotations
@@ -28,13 +30,13 @@ import cv2
 import numpy as np
 
 from .._compat import frozen
-from .color import UNIT_GAINS, Gains, grey_world_gains, relaxed_floors, to_hsv
+from .color import UNIT_GAINS, Gains, class_masks, clipped_mask, grey_world_gains, relaxed_floors, to_hsv
 from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, none_apart_filtered
 from .params import DetectionParams
 from .structure import Found, search, search_apart
 from .types import LandmarkGeometry
-from .yuv_table import BLUE, COLOUR_SPACES, NONE, RED, _rgb_matrix, class_table, clipped_table
+from .yuv_table import BLUE, COLOUR_SPACES, NONE, RED, _rgb_matrix, class_table, clipped_table, saturation_table
 
 __all__ = ["BLUE", "COLOUR_SPACES", "NONE", "RED", "Yuv420", "chroma_masks", "class_table", "half_luma",
            "yuv420_from_bgr", "yuv420_planes", "yuv_grey_world_gains", "yuv_search", "yuv_to_bgr"]
@@ -162,7 +164,9 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
     raw = None  # the unbalanced (U, V) index and Y, when a gain below one may hide a clipped channel
     if min(gains) < 0.98:
         raw = (_uv_index(u, v), y)
-    if not all(abs(g - 1.0) <= 0.02 for g in gains):
+    unbalanced = (y, u, v)
+    balanced = not all(abs(g - 1.0) <= 0.02 for g in gains)
+    if balanced:
         y, u, v = _balance(y, np.ascontiguousarray(u), np.ascontiguousarray(v), gains, yuv.colour_space)
     keys = (yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)), int(cfg.s_min))
     idx = _uv_index(u, v)
@@ -179,7 +183,22 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
     ok = cv2.bitwise_and(clip, cv2.compare(y, yhi, cv2.CMP_LE))
     red = cv2.bitwise_or(red, cv2.bitwise_and(cv2.compare(cls, RED, cv2.CMP_EQ), ok))
     blue = cv2.bitwise_or(blue, cv2.bitwise_and(cv2.compare(cls, BLUE, cv2.CMP_EQ), ok))
+    if balanced and max(gains) > 1.0:  # a gain above one may saturate a channel at 255, as apply_gains does
+        over = cv2.compare(y, saturation_table(yuv.colour_space).take(idx), cv2.CMP_GT)
+        if cv2.countNonZero(over):
+            _saturated(red, blue, np.nonzero(over), unbalanced, cfg, gains, yuv.colour_space)
     return red, blue
+
+
+def _saturated(red: np.ndarray, blue: np.ndarray, where: Tuple[np.ndarray, np.ndarray], planes: Tuple[np.ndarray, ...],
+               cfg: DetectionParams, gains: Gains, colour_space: str) -> None:
+    """Class the pixels at ``where`` as the BGR path does, from their balanced and saturated BGR (in place)."""
+    y, u, v = (p[where].reshape(-1, 1) for p in planes)
+    raw = yuv_to_bgr(y, u, v, colour_space)
+    clipped = clipped_mask(raw) if min(gains) < 0.98 else None
+    r, b = class_masks(to_hsv(yuv_to_bgr(y, u, v, colour_space, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min,
+                       cfg.v_min, clipped)
+    red[where], blue[where] = r[:, 0], b[:, 0]
 
 
 def _uv_index(u: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -123,3 +123,16 @@ def clipped_table(colour_space: str, red_hue: tuple, blue_hue: tuple, s_min: int
     yclip = np.clip(yclip, 0, 255).astype(np.uint32)  # ≤ y0 + 249.5 / a: max(R, G, B) - a(Y - y0) is never < 0
     yhi = np.where(cls == NONE, 0, np.clip(yhi, 0, 255)).astype(np.uint32)
     return (yclip | (yhi << 8) | (cls << 16) | (yclip << 24)).reshape(-1)
+
+
+@functools.lru_cache(maxsize=4)
+def saturation_table(colour_space: str) -> np.ndarray:
+    """(65536,) uint8 table indexed by ``U << 8 | V``: the greatest Y whose max(R, G, B) rounds to 255 or less.
+
+    A balanced pixel above it has a channel the BGR path's gains saturate at 255
+    (:func:`~rangebearing.core.color.apply_gains`), which moves its hue and
+    saturation in a way no (U, V) table holds.
+    """
+    a, y0 = COLOUR_SPACES[colour_space][:2]
+    _, top, _ = _chroma_planes(colour_space)
+    return np.clip(np.floor(y0 + (255.5 - top) / a), 0, 255).astype(np.uint8).reshape(-1)
