@@ -105,13 +105,7 @@ def side_view(
     size = (half, h // 2)  # every other pixel of each strip: the full scan's resolution
     strips = cv2.hconcat([cv2.resize(bgr[:, :s], size, interpolation=cv2.INTER_NEAREST),
                           cv2.resize(bgr[:, w - s :], size, interpolation=cv2.INTER_NEAREST)])
-    red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
-    for y0, y1, c0, c1 in cuts:
-        red[y0:y1, c0:c1] = 0
-        blue[y0:y1, c0:c1] = 0
-    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
-    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
-    both = (n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX)
+    both = _both_colours(strips, cfg, gains, cuts)
     counts = (int(np.count_nonzero(both[:half])), int(np.count_nonzero(both[half:])))
     return SideView(counts, probe, cuts, gains)
 
@@ -146,16 +140,8 @@ BESIDE_GAP_PX = 2  # full-resolution columns between a box and its strips: its o
 def beside_count(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Sequence[BBox]) -> int:
     """Landmark-like columns (half resolution, as :func:`side_colour` counts them) right beside ``boxes``.
 
-    Parameters
-    ----------
-    bgr : (H, W, 3) uint8
-        The full-resolution frame.
-    cfg : DetectionParams
-        Hue ranges and the S/V thresholds of the full scan.
-    gains : Gains
-        The balance the full scan classified with.
-    boxes : sequence of BBox
-        Full-resolution boxes of the followed landmarks (their columns are not counted).
+    The parameters are :func:`side_colour`'s; ``boxes`` are the followed landmarks' (full-resolution),
+    and their own columns are not counted.
     """
     h, w = bgr.shape[:2]
     strips, xs = [], []
@@ -175,10 +161,19 @@ def beside_count(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Seq
     for s in strips:
         img[: s.shape[0], at : at + s.shape[1]] = s
         at += s.shape[1]
-    red, blue = class_masks(to_hsv(apply_gains(img, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
-    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
-    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
     x = np.concatenate(xs)
     b = np.asarray(boxes, np.int64).reshape(-1, 4)
     followed = ((x[:, None] >= b[None, :, 0]) & (x[:, None] < b[None, :, 0] + b[None, :, 2])).any(axis=1)
-    return int(np.count_nonzero((n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX) & ~followed))
+    return int(np.count_nonzero(_both_colours(img, cfg, gains) & ~followed))
+
+
+def _both_colours(strips: np.ndarray, cfg: DetectionParams, gains: Gains, cuts: Sequence[Cut] = ()) -> np.ndarray:
+    """(columns,) bool: which columns of ``strips`` (BGR) hold ``MIN_PX`` red and ``MIN_PX`` blue class pixels,
+    the ``cuts`` (rows and columns of ``strips``) blanked first."""
+    red, blue = class_masks(to_hsv(apply_gains(strips, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min)
+    for y0, y1, c0, c1 in cuts:
+        red[y0:y1, c0:c1] = 0
+        blue[y0:y1, c0:c1] = 0
+    n_red = cv2.reduce(red, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    n_blue = cv2.reduce(blue, 0, cv2.REDUCE_SUM, dtype=cv2.CV_32S)[0]
+    return (n_red >= 255 * MIN_PX) & (n_blue >= 255 * MIN_PX)

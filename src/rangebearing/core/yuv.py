@@ -165,8 +165,8 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
     if min(gains) < 0.98:
         raw = (_uv_index(u, v), y)
     unbalanced = (y, u, v)
-    balanced = not all(abs(g - 1.0) <= 0.02 for g in gains)
-    if balanced:
+    gains_applied = not all(abs(g - 1.0) <= 0.02 for g in gains)
+    if gains_applied:
         y, u, v = _balance(y, np.ascontiguousarray(u), np.ascontiguousarray(v), gains, yuv.colour_space)
     keys = (yuv.colour_space, tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)), int(cfg.s_min))
     idx = _uv_index(u, v)
@@ -183,7 +183,7 @@ def chroma_masks(yuv: Yuv420, cfg: DetectionParams, gains: Gains = UNIT_GAINS,
     ok = cv2.bitwise_and(clip, cv2.compare(y, yhi, cv2.CMP_LE))
     red = cv2.bitwise_or(red, cv2.bitwise_and(cv2.compare(cls, RED, cv2.CMP_EQ), ok))
     blue = cv2.bitwise_or(blue, cv2.bitwise_and(cv2.compare(cls, BLUE, cv2.CMP_EQ), ok))
-    if balanced and max(gains) > 1.0:  # a gain above one may saturate a channel at 255, as apply_gains does
+    if gains_applied and max(gains) > 1.0:  # a gain above one may saturate a channel at 255, as apply_gains does
         over = cv2.compare(y, saturation_table(yuv.colour_space).take(idx), cv2.CMP_GT)
         if cv2.countNonZero(over):
             _saturated(red, blue, np.nonzero(over), unbalanced, cfg, gains, yuv.colour_space)
