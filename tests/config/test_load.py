@@ -79,6 +79,8 @@ def test_every_problem_is_named_at_once(tmp_path):
         ("landmark: {band_height_m: 0.04}\n", "two bands do not fit"),
         ("detection: {tracking: 'yes'}\n", "expected true or false"),
         ("source: {controls: {aeenable: 1}}\n", "source.controls"),
+        ("detection: {full_scan_interval_s: -0.1}\n", "detection.full_scan_interval_s"),
+        ("detection: {full_scan_interval_s: 1e9}\n", "detection.full_scan_interval_s"),
     ],
 )
 def test_specific_problems(tmp_path, text, fragment):

@@ -11,7 +11,8 @@ from rangebearing import Pipeline, load_config
 
 def _pipes(full_scan_every: int = 4):
     cfg = load_config(None)
-    cfg = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, full_scan_every=full_scan_every))
+    cfg = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, full_scan_every=full_scan_every,
+                                                                  full_scan_interval_s=0.0))
     return Pipeline(cfg.pipeline, track=True), Pipeline(cfg.pipeline, track=True)
 
 

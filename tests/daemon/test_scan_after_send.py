@@ -12,7 +12,8 @@ from tests.daemon.test_loop import RecordingNotifier, opener, recorded_cfg
 
 def _run(clip, scan_after_send: bool):
     cfg = recorded_cfg(clip)
-    cfg = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, full_scan_every=3),
+    det = dataclasses.replace(cfg.detection, full_scan_every=3, full_scan_interval_s=0.0)  # every 3rd frame
+    cfg = dataclasses.replace(cfg, detection=det,
                               daemon=dataclasses.replace(cfg.daemon, scan_after_send=scan_after_send))
     pub, note = MemoryPublisher(), RecordingNotifier(watchdog_s=1e-6)
     daemon = Daemon(cfg, opener, lambda c: pub, note)

@@ -148,6 +148,7 @@ SCHEMA: Dict[str, Tuple[type, Dict[str, ck.Check]]] = {
             "max_landmarks": ck.number(1, MAX_LANDMARKS, integer=True),
             "tracking": ck.boolean,
             "full_scan_every": ck.positive(True),
+            "full_scan_interval_s": ck.number(0, 60),
         },
     ),
     "model": (

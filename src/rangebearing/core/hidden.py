@@ -4,7 +4,7 @@ Window tracking finds no newcomer, and a landmark that a nearer one passes in
 front of leaves the tracks at the full scan that no longer sees it. When it
 comes out again it would stay unreported until the next scheduled full scan.
 A landmark that vanishes where a found landmark now stands is therefore kept
-here, where it was last seen, for up to ``full_scan_every`` frames: while a
+here, where it was last seen, for up to ``full_scan_every`` full scans: while a
 tracked landmark covers that place, the pipeline scans the whole frame
 (:func:`.scans.crossing` over tracks and hidden ones), and the first scan
 that sees it again makes it a track.

@@ -1,8 +1,8 @@
 """Newcomers at the frame's sides: band colour appearing where no followed landmark is.
 
 Window tracking measures only the landmarks it follows, so a landmark coming
-into view waits for the next scheduled full scan, up to ``full_scan_every - 1``
-frames, though it is findable from the frame it is 60 % in view. Landmarks
+into view waits for the next scheduled full scan, up to ``full_scan_interval_s``
+(or ``full_scan_every - 1`` frames), though it is findable from the frame it is 60 % in view. Landmarks
 come into view at the frame's left and right sides (a neighbour driving in, the
 observer turning). Each frame the two side strips are classified at the full
 scan's half resolution (a few small calls: two strips of ``EDGE_STRIP_PX``

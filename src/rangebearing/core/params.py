@@ -36,7 +36,9 @@ class DetectionParams:
     # fit one datagram and counts the rest (net/fit.py), so this is not bounded by the packet size
     max_landmarks: int = 16
     tracking: bool = True
-    full_scan_every: int = 8
+    full_scan_every: int = 8  # frames between periodic full scans, when full_scan_interval_s is 0
+    # capture time between periodic full scans (a newcomer in mid-view shows within it, at any frame rate)
+    full_scan_interval_s: float = 0.25
 
 
 @frozen

@@ -3,8 +3,8 @@
 :class:`Pipeline` is pure apart from its own state: when tracking it keeps the
 previous frame's landmarks and measures them again in small windows where they
 should be (:mod:`rangebearing.core.tracking`), with a full-frame search every
-``full_scan_every`` frames, after a landmark is lost, and whenever nothing is
-tracked, so a newcomer is found within ``full_scan_every`` frames.
+``full_scan_interval_s`` of capture time (or ``full_scan_every`` frames; :func:`.scans.scan_due`),
+after a landmark is lost, and whenever nothing is tracked, so a newcomer is found within that.
 
 Every landmark of a sequence also gets a stable ``track_id`` and, once its
 track has history, range and bearing rates (:mod:`rangebearing.core.identity`,
@@ -31,7 +31,7 @@ from .newcomers import NEW_COLUMNS, SideCounts, SideView, beside_count, came_in,
 from .pairing import PairingLimits
 from .params import PipelineParams
 from .refine import Pyramid
-from .scans import crossing, rescanned
+from .scans import Cadence, crossing, periodic, rescanned, scan_due
 from .search_image import SearchImage
 from .structure import Found
 from .tracking import Track, step
@@ -96,7 +96,7 @@ class Pipeline:
         self._tracks: List[Track] = []
         self._lost: List[Track] = []  # tracks the last (tracked) frame lost
         self._hidden: List[Hidden] = []
-        self._since_scan = 0
+        self._cadence = Cadence()
         self._sides: SideCounts = (0, 0)
         self._side_view: Optional[SideView] = None  # the strips' counts as last classified (core/newcomers.py)
         self._beside = 0  # landmark-like columns beside the tracks at the last full scan (newcomers.beside_count)
@@ -146,7 +146,7 @@ class Pipeline:
         if det.method == "paper":
             found = detect_paper(bgr, det)
         else:
-            tracking = self.track and self._tracks and self._since_scan < det.full_scan_every - 1
+            tracking = self.track and self._tracks and not self._scan_due(t_s)
             # landmarks crossing, one coming out from behind another, or one coming into view: a full scan
             if (tracking and not crossing([*self._tracks, *tracks_of(self._hidden)])
                     and not came_in(self._sides_now(bgr), self._sides)):
@@ -156,7 +156,7 @@ class Pipeline:
                 # ... or one came out from behind a followed one (core/newcomers.py): scanned whole, once
                 if not lost and self._beside_now(bgr, kept) < self._beside + NEW_COLUMNS:
                     self._tracks, self._lost = kept, lost
-                    self._since_scan += 1
+                    self._cadence = Cadence(self._cadence.tracked + 1, self._cadence.scan_t_s)
                     found = [t.bands for t in self._tracks]
                     tracked = True
             else:
@@ -198,7 +198,7 @@ class Pipeline:
                     self._sides = self._sides_now(bgr)
                     self._beside = self._beside_now(bgr, self._tracks)
                 # what lost a landmark (one passing behind another, coming out) is still under way: the next frame too
-                self._since_scan = det.full_scan_every - 1 if lost else 0
+                self._cadence = Cadence(0, t_s, forced=bool(lost))
         # a range that is not positive is no landmark (e.g. a calibration with a large negative c, up close),
         # nor is one beyond MAX_RANGE_M
         readings = sorted((r for r in (self._reading(c, cam, bgr) for c in found) if 0 < r[0] <= MAX_RANGE_M),
@@ -235,16 +235,17 @@ class Pipeline:
         full scan).
         """
         det = self.params.detection
-        due = (self.track and bool(self._tracks) and det.method != "paper" and det.full_scan_every > 1
-               and self._since_scan == det.full_scan_every - 1)
+        due = (self.track and bool(self._tracks) and det.method != "paper" and self._scan_due(t_s)
+               and periodic(self._cadence, det.full_scan_every, det.full_scan_interval_s))
         if not due:
             return self.process(frame, t_s, search), None
         before = dict(self.__dict__)  # the state is rebound, never changed in place: a shallow copy keeps it
-        self._since_scan -= 1
+        self._cadence = dataclasses.replace(self._cadence, held=True)
         result = self.process(frame, t_s, search)
         if not result.tracked:  # a full scan was needed anyway (crossing, a newcomer): done already
             return result, None
-        self._since_scan = det.full_scan_every  # left unfinished, the scan is the next frame's (never deferred)
+        # left unfinished, the scan is the next frame's (never deferred)
+        self._cadence = dataclasses.replace(self._cadence, forced=True)
         after = dict(self.__dict__)
 
         def finish() -> FrameResult:
@@ -256,6 +257,11 @@ class Pipeline:
                 raise
 
         return result, finish
+
+    def _scan_due(self, t_s: Optional[float]) -> bool:
+        det = self.params.detection
+        return scan_due(self._cadence, t_s, det.full_scan_every, det.full_scan_interval_s,
+                        self.params.identity.nominal_dt_s)
 
     def _sides_now(self, bgr: np.ndarray) -> SideCounts:
         """The side strips' landmark-like columns, the followed landmarks blanked; classified again only when

@@ -1,5 +1,7 @@
 """When the whole frame is scanned instead of windows, and how its landmarks continue the tracks.
 
+:func:`scan_due` says when the periodic full scan is due (:class:`Cadence`: in
+capture time, ``full_scan_interval_s``, or every ``full_scan_every`` frames);
 :func:`crossing` says when followed landmarks are about to meet in the image
 (the caller then scans the whole frame); :func:`rescanned` turns a full scan's
 landmarks into tracks that keep the image velocity of the ones they continue.
@@ -7,13 +9,55 @@ landmarks into tracks that keep the image velocity of the ones they continue.
 
 from __future__ import annotations
 
-from typing import List, Sequence
+from typing import List, Optional, Sequence
 
+from .._compat import frozen
 from .detect import BandCentroids
 from .tracking import Track, search_boxes
 from .types import XY
 
 WIDTH_RATIO = 1.6  # a landmark found again by a full scan: about as wide as it was
+DUE_SLACK_S = 1e-6  # a scan due at exactly the interval is due whatever the rounding of the frames' times
+
+
+@frozen
+class Cadence:
+    """Where the periodic full scan stands between frames."""
+
+    tracked: int = 0  # frames tracked since the last full scan
+    scan_t_s: Optional[float] = None  # the capture time of the last full scan (None: the frames carry none)
+    forced: bool = False  # the next frame is scanned whole (a track was lost; a scan left unfinished)
+    held: bool = False  # this frame's periodic scan is left for after its readings (Pipeline.process_scan_later)
+
+
+def scan_due(c: Cadence, t_s: Optional[float], every: int, interval_s: float, nominal_dt_s: float) -> bool:
+    """Whether the frame captured at ``t_s`` is scanned whole for the cadence's sake (tracks or not).
+
+    With ``interval_s`` > 0 the periodic scan is due once that much capture
+    time has passed since the last full scan, whatever the frame rate (a
+    newcomer in mid-view shows within ``interval_s`` plus a frame); frames
+    without a time are ``nominal_dt_s`` apart, and a clock that went back
+    (another run) makes it due. With ``interval_s`` = 0 it is due every
+    ``every`` frames.
+    """
+    if c.forced:
+        return True
+    if c.held:
+        return False
+    if interval_s <= 0:
+        return c.tracked >= every - 1
+    if t_s is None or c.scan_t_s is None:
+        elapsed = (c.tracked + 1) * nominal_dt_s
+    else:
+        elapsed = t_s - c.scan_t_s
+        if elapsed < 0:
+            return True
+    return elapsed >= interval_s - DUE_SLACK_S
+
+
+def periodic(c: Cadence, every: int, interval_s: float) -> bool:
+    """Whether a due scan (:func:`scan_due`) would be the periodic one only, which may be left for later."""
+    return not c.forced and (interval_s > 0 or every > 1)
 
 
 def crossing(tracks: Sequence[Track], slack_px: float = 2.0) -> bool:
