@@ -45,8 +45,9 @@ def test_arrays_come_back_equal_read_only_and_the_same_objects() -> None:
 
 
 @linux_only
-def test_released_frames_leave_the_process_memory() -> None:
-    store = ClipStore()
+@pytest.mark.parametrize("batch_mib", [0, 4, cs.BATCH_BYTES / 2**20])
+def test_released_frames_leave_the_process_memory(batch_mib: float) -> None:
+    store = ClipStore(batch_bytes=int(batch_mib * 2**20))
     views = []
     for i in range(16):  # 14 MiB of frames, written once
         v = store.put(i, [np.full((480, 640, 3), i, np.uint8)])
@@ -59,8 +60,12 @@ def test_released_frames_leave_the_process_memory() -> None:
         assert int(v[240, 320, 1]) == i and int(v.max()) == i
         store.release()
     grown_mib = (_rss_kib() - before) / 1024
+    store.release(now=True)
+    dropped_mib = (_rss_kib() - before) / 1024
     store.close()
-    assert grown_mib < 6, grown_mib  # 14 MiB of frames were used; a frame or two's pages may be mapped
+    # 14 MiB of frames were used; those since the last drop (< batch_mib) and a frame or two may be mapped
+    assert grown_mib < batch_mib + 6, grown_mib
+    assert dropped_mib < 3, dropped_mib  # now: every one dropped
 
 
 def test_a_temp_dir_it_cannot_write_keeps_frames_in_memory(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

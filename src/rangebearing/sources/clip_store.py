@@ -6,7 +6,9 @@ holding it decoded in the heap made it most of the daemon's resident memory
 written once to an unlinked temporary file and handed out as a read-only view
 of a shared mapping of it. After the caller is done with a frame (its next
 read), :meth:`ClipStore.release` drops those pages from the process
-(``MADV_DONTNEED``): the next use maps them in again from the page cache,
+(``MADV_DONTNEED``) once the frames handed out since the last drop span
+:data:`BATCH_BYTES` (one call for ~6 VGA frames: the call, not the pages, is
+most of its cost, ~40 µs a frame): the next use maps them in again from the page cache,
 which the kernel may also reclaim and read back from the file. On a tmpfs
 temp dir the clip stays in RAM, as shared memory outside the process's RSS
 (``TMPDIR`` picks the directory). Dropping pages never changes what a view
@@ -29,6 +31,7 @@ import numpy as np
 CAN_RELEASE = hasattr(mmap.mmap, "madvise") and hasattr(mmap, "MADV_DONTNEED")
 LIMIT_BYTES = 512 * 1024 * 1024  # of temporary file: ~380 VGA frames with their YUV420
 CHUNK_BYTES = 64 * 1024 * 1024  # mapped at a time (address space, on 32-bit Raspberry Pi OS too)
+BATCH_BYTES = 8 * 1024 * 1024  # frames handed out before their pages are dropped: the RSS they may add
 
 
 class ClipStore:
@@ -39,9 +42,11 @@ class ClipStore:
     pages a read used are one span and :meth:`release` is one ``madvise`` call.
     """
 
-    def __init__(self, limit_bytes: int = LIMIT_BYTES, chunk_bytes: int = CHUNK_BYTES) -> None:
+    def __init__(self, limit_bytes: int = LIMIT_BYTES, chunk_bytes: int = CHUNK_BYTES,
+                 batch_bytes: int = BATCH_BYTES) -> None:
         self.limit_bytes = limit_bytes
         self.chunk_bytes = chunk_bytes
+        self.batch_bytes = batch_bytes
         self.failed = not CAN_RELEASE
         self._file: Optional[int] = None
         self._chunks: List[mmap.mmap] = []
@@ -104,8 +109,11 @@ class ClipStore:
         lo, hi = self._spans.get(chunk, (start, end))
         self._spans[chunk] = (min(lo, start), max(hi, end))
 
-    def release(self) -> None:
-        """Drop the pages handed out since the last call from this process's memory (one span a chunk)."""
+    def release(self, now: bool = False) -> None:
+        """The caller is done with what it was handed: drop those pages from this process's memory (one span a
+        chunk) once they span ``batch_bytes`` since the last drop, or ``now``."""
+        if not now and sum(hi - lo for lo, hi in self._spans.values()) < self.batch_bytes:
+            return
         for chunk, (lo, hi) in self._spans.items():
             with contextlib.suppress(OSError, ValueError):  # refused: the pages just stay mapped
                 self._chunks[chunk].madvise(mmap.MADV_DONTNEED, lo, hi - lo)
