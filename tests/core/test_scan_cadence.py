@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
@@ -75,3 +76,14 @@ def test_at_90_fps_a_newcomer_in_mid_view_shows_within_the_interval_and_fewer_fr
     before = [i for i in scanned if i < appears]
     assert before == [0]  # every 8th frame would have scanned frame 8 too
     assert scanned[-1] == found_at
+
+
+@pytest.mark.parametrize("every, interval_s", [(1, 0.0), (8, 0.001)])
+def test_when_every_frame_is_scanned_no_scan_is_left_for_after_the_send(every, interval_s):
+    cfg = load_config(None)
+    cfg = dataclasses.replace(cfg, detection=dataclasses.replace(cfg.detection, full_scan_every=every,
+                                                                  full_scan_interval_s=interval_s))
+    pipe = Pipeline(cfg.pipeline, track=True)
+    for i, img in enumerate(moving_sequence(4)):
+        result, finish = pipe.process_scan_later(img, t_s=i / 30)
+        assert finish is None and not result.tracked and len(result.landmarks) == 2

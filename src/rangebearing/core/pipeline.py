@@ -236,7 +236,7 @@ class Pipeline:
         """
         det = self.params.detection
         due = (self.track and bool(self._tracks) and det.method != "paper" and self._scan_due(t_s)
-               and periodic(self._cadence, det.full_scan_every, det.full_scan_interval_s))
+               and periodic(self._cadence))
         if not due:
             return self.process(frame, t_s, search), None
         before = dict(self.__dict__)  # the state is rebound, never changed in place: a shallow copy keeps it

@@ -55,9 +55,14 @@ def scan_due(c: Cadence, t_s: Optional[float], every: int, interval_s: float, no
     return elapsed >= interval_s - DUE_SLACK_S
 
 
-def periodic(c: Cadence, every: int, interval_s: float) -> bool:
-    """Whether a due scan (:func:`scan_due`) would be the periodic one only, which may be left for later."""
-    return not c.forced and (interval_s > 0 or every > 1)
+def periodic(c: Cadence) -> bool:
+    """Whether a due scan (:func:`scan_due`) would be the periodic one only, which may be left for later.
+
+    Not when forced, nor when no frame was tracked since the last full scan: then every frame is scanned
+    (``full_scan_every: 1``, or an interval shorter than a frame), and leaving each frame's scan for after
+    its send would only add a tracked step to every frame.
+    """
+    return not c.forced and c.tracked >= 1
 
 
 def crossing(tracks: Sequence[Track], slack_px: float = 2.0) -> bool:
