@@ -6,6 +6,8 @@ gives ENOSPC; both are an OSError on write or close), so the tests need no root 
 
 from __future__ import annotations
 
+import errno
+import io
 import os
 import resource
 import signal
@@ -111,3 +113,41 @@ def test_a_recording_that_cannot_even_start_on_a_full_disk_is_one_error_and_no_e
     assert status == 1
     assert len(error_lines(err)) == 1 and str(out) in error_lines(err)[0] and "File too large" in err, err
     assert not out.exists()
+
+
+class _FullStream(io.StringIO):
+    """stdout on a full disk (``> /dev/full``): every write that reaches the file fails with ENOSPC."""
+
+    def flush(self) -> None:
+        if self.getvalue():
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+
+class _ClosedPipe(io.StringIO):
+    """stdout to a reader that went away (``| head`` done)."""
+
+    def flush(self) -> None:
+        if self.getvalue():
+            raise BrokenPipeError(errno.EPIPE, os.strerror(errno.EPIPE))
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["replay", "--help"], ["--version"]])
+def test_help_and_version_that_cannot_be_written_are_a_write_error(
+    argv: List[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(sys, "stdout", _FullStream())
+    assert main(argv) == 1  # argparse alone drops the OSError and exits 0
+    assert capsys.readouterr().err == f"rangebearing: error: {os.strerror(errno.ENOSPC)}\n"
+    monkeypatch.setattr(sys, "stdout", _ClosedPipe())
+    monkeypatch.setattr("rangebearing.cli.main._silence_stdout", lambda: None)
+    assert main(argv) == 0  # `--help | head` stays quiet, as any other command's output does
+    assert capsys.readouterr().err == ""
+
+
+def test_help_to_dev_full_exits_non_zero(tmp_path: Path) -> None:
+    if not os.path.exists("/dev/full"):
+        pytest.skip("no /dev/full here")
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "rangebearing.cli.main", "--help"], stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=TIMEOUT_S)
+    assert proc.returncode == 1 and proc.stderr.startswith("rangebearing: error: No space left"), proc.stderr

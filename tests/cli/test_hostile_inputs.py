@@ -348,3 +348,31 @@ def test_record_refuses_a_limit_that_records_nothing(limit: List[str], tmp_path:
         main(["record", "--source", str(clip), *limit, "--out", str(tmp_path / "out"), "-q"])
     assert info.value.code == 2
     assert not (tmp_path / "out").exists()
+
+
+WHY = {  # each skipped frame's line says why it is unreadable
+    "non-image files": {"003.png": "not an image (no PNG, JPEG or BMP header)"},
+    "truncated png and jpeg": {"003.png": "corrupt or truncated", "004.jpg": "corrupt or truncated",
+                               "005.png": "an empty file (0 bytes)"},
+    "huge images": {"003.png": "its header says 40000×40000 = 1600000000 px, over the 67108864 px",
+                    "004.png": "its header says 9000×9000 = 81000000 px, over the 67108864 px"},
+    "broken links": {"003.png": "No such file or directory", "004.png": "Too many levels of symbolic links"},
+}
+
+
+@pytest.mark.parametrize("kind", sorted(WHY))
+def test_replay_and_the_daemon_say_why_a_frame_is_unreadable(
+    kind: str, tmp_path: Path, clip: Path, capsys: pytest.CaptureFixture[str], caplog: pytest.LogCaptureFixture
+) -> None:
+    path, _, _ = hostile_recording(kind, clip, tmp_path)
+    status, _, err = call(["replay", str(path), "-q"], capsys)
+    assert status == 0, err
+    skipped = {ln.split(": ", 1)[0]: ln for ln in err.splitlines() if ": skipped: " in ln}
+    for name, why in WHY[kind].items():
+        assert f"{name}: skipped: unreadable image: {why}" in skipped[name], err
+    caplog.set_level(logging.DEBUG, logger="rangebearing")
+    status, _, err = call(["run", "--source", str(path), "--fps", "0"], capsys)
+    assert status == 0, err
+    logged = "\n".join(r.getMessage() for r in caplog.records) + err
+    for name, why in WHY[kind].items():
+        assert f"{name}: unreadable image: {why}" in logged, logged

@@ -110,3 +110,20 @@ def test_a_duplicated_row_or_column_is_refused(tmp_path: Path, text: str, says: 
     path.write_text(text)
     with pytest.raises(TruthError, match=re.escape(says)):
         read_truth(path)
+
+
+def test_rows_read_as_lists_keep_what_a_reader_by_name_accepted(tmp_path: Path) -> None:
+    # padded numbers, exponents, blank lines, cells past the header, a frame name with spaces
+    text = ("\nframe , range_m,bearing_rad\n a b.png , 1.5 ,+0.2\n\n"
+            "a b.png,1e-1,-3.14159,extra,cells\n002.png,0.3,0.0\n")
+    path = tmp_path / "t.csv"
+    path.write_text(text)
+    truth = read_truth(path)
+    assert truth == {"a b.png": [TruthRow("a b.png", 1.5, 0.2), TruthRow("a b.png", 0.1, -3.14159)],
+                     "002.png": [TruthRow("002.png", 0.3, 0.0)]}
+    path.write_text("frame,range_m,bearing_rad\n001.png,inf,0\n001.png,1,nan\n001.png,0.5\n")
+    with pytest.raises(TruthError) as bad:
+        read_truth(path)
+    assert [ln.strip() for ln in str(bad.value).splitlines()[1:]] == [
+        f"{path}:2: range_m 'inf' is not finite", f"{path}:3: bearing_rad 'nan' is not finite",
+        f"{path}:4: too few fields"]

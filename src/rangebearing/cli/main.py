@@ -18,7 +18,7 @@ import logging
 import os
 import sys
 import threading
-from typing import Dict, List, Optional
+from typing import IO, Dict, List, Optional
 
 from .. import __version__, _signals
 from ..errors import ConfigError, RangeBearingError
@@ -68,9 +68,24 @@ def _columns() -> int:
     return columns if columns > 0 else 80
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, but ``--help`` / ``--version`` that cannot be written (``> /dev/full``) are an error.
+
+    argparse drops an OSError from writing them and exits 0; stdout is flushed
+    here so the failure reaches :func:`main`'s funnel, as any other write's does.
+    """
+
+    def _print_message(self, message: str, file: Optional[IO[str]] = None) -> None:
+        if not message or (file is not None and file is not sys.stdout):
+            super()._print_message(message, file)  # usage and errors on stderr: nothing to tell if it fails
+            return
+        sys.stdout.write(message)
+        sys.stdout.flush()
+
+
 def common_options() -> argparse.ArgumentParser:
     """Options accepted both before and after the command name (``rangebearing -v run`` = ``run -v``)."""
-    p = argparse.ArgumentParser(add_help=False, formatter_class=_Formatter)
+    p = _Parser(add_help=False, formatter_class=_Formatter)
     p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help="log debug messages")
     p.add_argument(
         "--debug", action="store_true", default=argparse.SUPPRESS, help="show the traceback of an error"
@@ -91,7 +106,7 @@ def chosen_command(argv: List[str]) -> Optional[str]:
 def build_parser(argv: Optional[List[str]] = None) -> argparse.ArgumentParser:
     """The parser; only the command named in ``argv`` (all of them when ``None``) is imported."""
     common = common_options()
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rangebearing",
         description="Range and bearing to red/blue cylinder landmarks, from a camera or recorded frames.",
         epilog="Run 'rangebearing COMMAND --help' for each command's options.",
@@ -160,7 +175,14 @@ def main(argv: Optional[List[str]] = None) -> int:
 
 def _run(args_list: List[str]) -> int:
     parser = build_parser(args_list)
-    args = parser.parse_args(args_list)
+    try:
+        args = parser.parse_args(args_list)
+    except BrokenPipeError:  # --help | head
+        _silence_stdout()
+        return 0
+    except OSError as exc:  # --help > /dev/full
+        print(f"rangebearing: error: {describe_error(exc)}", file=sys.stderr, flush=True)
+        return EXIT_ERROR
     debug = getattr(args, "debug", False) or os.environ.get("RANGEBEARING_DEBUG", "") not in ("", "0")
     logging.basicConfig(
         level=logging.DEBUG if getattr(args, "verbose", False) else logging.INFO,

@@ -18,6 +18,7 @@ from ..evaluation.annotate import annotate
 from ..evaluation.identity import format_id_report, id_report
 from ..evaluation.match import accuracy, format_report
 from ..net.protocol import landmark_fields
+from ..sources.image_bytes import why_undecodable
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import add_config_arg, aligned_truth, config_from_args, describe, progress
 from .outputs import AtomicText, check_output_dir, check_output_file, write_bytes_atomic
@@ -67,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
             done += 1
             try:
                 if image is None:
-                    raise FrameError("unreadable image")
+                    why = f": {why_undecodable(path / name)}" if path.is_dir() else ""
+                    raise FrameError(f"unreadable image{why}")
                 result = process_or_skip(pipe, image)
             except FrameError as exc:  # a bad frame, or a detector defect on it (DetectorFault): skipped, counted
                 bad += 1

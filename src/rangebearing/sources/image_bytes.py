@@ -86,3 +86,28 @@ def decode_file(path: Union[str, os.PathLike[str]]) -> Optional[np.ndarray]:
     except (OSError, ValueError):  # a directory, a symlink loop, a NUL in the name
         return None
     return None if len(data) > MAX_FILE_BYTES else decode(data)
+
+
+def why_undecodable(path: Union[str, os.PathLike[str]]) -> str:
+    """Why :func:`decode_file` gives ``None`` for ``path``, in a few words (called only once it has)."""
+    try:
+        with open(path, "rb") as f:
+            size = os.fstat(f.fileno()).st_size
+            head = f.read(64 * 1024)
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+    except ValueError as exc:  # a NUL in the name
+        return str(exc)
+    if size == 0:
+        return "an empty file (0 bytes)"
+    if size > MAX_FILE_BYTES:
+        return f"{size} bytes, over the {MAX_FILE_BYTES >> 20} MiB an image file may take"
+    claimed = header_size(head)
+    if claimed is not None and claimed[0] * claimed[1] > MAX_PIXELS:
+        w, h = claimed
+        return f"its header says {w}×{h} = {w * h} px, over the {MAX_PIXELS} px (8192×8192) a frame may have"
+    if claimed is not None and 0 in claimed:
+        return f"its header says {claimed[0]}×{claimed[1]}: no pixels"
+    if claimed is None and not head.startswith((b"\x89PNG", b"BM", b"\xff\xd8")):
+        return "not an image (no PNG, JPEG or BMP header)"
+    return "corrupt or truncated: the decoder gives no image"

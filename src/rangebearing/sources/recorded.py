@@ -13,7 +13,7 @@ from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
 from .clip_store import ClipStore
-from .image_bytes import decode_file
+from .image_bytes import decode_file, why_undecodable
 from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
 from .pacing import Pacer
 from .video_frames import END, EndOfVideo, VideoFrames, open_video
@@ -107,10 +107,9 @@ Fetched = Union[Optional[np.ndarray], EndOfVideo]
 class _ImageDir:
     """Random access to a directory's images, decoded once when looping.
 
-    Decoded frames go to ``store`` (the page cache, :mod:`.clip_store`), or
-    into a bounded in-memory cache where it cannot take them. Kept frames are
-    read-only; ``in_place`` hands them out as they are (a camera's buffers are
-    not copied either), otherwise each is a copy the caller may draw on.
+    Decoded frames go to ``store`` (the page cache, :mod:`.clip_store`), or into a bounded in-memory
+    cache where it cannot take them. Kept frames are read-only; ``in_place`` hands them out as they
+    are (a camera's buffers are not copied either), otherwise each is a copy the caller may draw on.
     """
 
     def __init__(self, directory: Path, cache: bool, in_place: bool = False,
@@ -255,7 +254,8 @@ class RecordedSource:
             return None
         self._next = i + 1
         if fetched[1] is None:
-            raise FrameError(f"{reader.name(fetched[0])}: cannot decode image")
+            why = why_undecodable(reader.paths[fetched[0]]) if isinstance(reader, _ImageDir) else "cannot decode"
+            raise FrameError(f"{reader.name(fetched[0])}: unreadable image: {why}")
         return self._frame(reader, fetched, i)
 
     def _frame(self, reader: Reader, fetched: Tuple[int, Optional[np.ndarray]], i: int) -> Frame:
