@@ -359,3 +359,25 @@ def test_the_camera_reopens_after_close(camera: Camera) -> None:
         finally:
             source.close()
         assert camera.open_cameras() == set() and camera.held() == 0
+
+
+def test_frames_mapped_read_only_go_through_the_pipeline_untouched(alt_picamera2: Any) -> None:
+    """MappedArray(write=False) maps the buffer PROT_READ on the real library: nothing downstream may write it."""
+    from rangebearing.core.params import PipelineParams
+    from rangebearing.core.pipeline import Pipeline
+
+    module, rig = alt_picamera2
+    rig.RIG.scene = lambda seq: noise(seq, 480, 640)
+    source = open_source(Alt(module, rig), width_px=640, height_px=480)
+    try:
+        pipe = Pipeline(PipelineParams(), track=True)
+        for _ in range(3):
+            frame = source.read()
+            assert frame is not None and not frame.image.flags.writeable
+            lores = frame.lores_yuv420
+            assert lores is not None and not lores.y.flags.writeable
+            before = frame.image.copy()
+            pipe.process(frame.image, t_s=frame.t_mono_ns / 1e9, search=lores)
+            assert (frame.image == before).all()
+    finally:
+        source.close()

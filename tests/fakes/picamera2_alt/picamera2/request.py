@@ -43,6 +43,7 @@ class MappedArray:
         self.__request = request
         self.__stream = stream
         self.__reshape = reshape
+        self.__write = write
         self.__array: Optional[np.ndarray] = None
         if request.request is None:  # _MappedBuffer asserts request.request is not None (request.py:34)
             raise AssertionError("request already released")
@@ -54,7 +55,11 @@ class MappedArray:
         buffer = request.request.buffers.get(self.__stream)
         if buffer is None:  # the real one fails looking the stream up in stream_map (request.py:32)
             raise KeyError(self.__stream)
-        self.__array = make_array_shared(buffer, request.config[self.__stream]) if self.__reshape else buffer
+        array = make_array_shared(buffer, request.config[self.__stream]) if self.__reshape else buffer
+        if not self.__write:  # _MappedBuffer: allocator.sync(..., write) maps PROT_READ only: a read-only array
+            array = array.view()
+            array.setflags(write=False)
+        self.__array = array
         return self
 
     def __exit__(self, *exc: Any) -> None:
