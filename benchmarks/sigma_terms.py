@@ -18,6 +18,11 @@ to ``-s<seed>``, seeds pooled) it prints:
   ``floor`` (EDGE_FLOOR_PX, MODEL_FLOOR); bearing ``column``, ``spread``, ``shading``, ``hidden``,
   ``cut``, ``floor``.
 
+``--split tracked|kind|column|seed`` adds a line per set and frame type (tracked or full scan), kind of
+reading (``whole``, ``cut1``/``cut2`` cut on one side/both, ``H`` partly hidden, ``M`` a merged band),
+column source (the bands' ``moments`` or a ``limb``) or seed: a set's cover can hide groups that balance
+each other (a 300-frame sequence is one seed: its robots share one light, so one bias).
+
 ``--share NAME=VALUE`` (a constant of ``core/uncertainty.py``, e.g. ``SPREAD_SHARE=0.7``; repeatable)
 recomputes every sigma from the kept inputs with that value and prints the cover again, so a re-fit
 can be tried on many sets without replaying them (``row_spread_px``'s inputs are kept too, so
@@ -41,6 +46,7 @@ from rangebearing.cli.common import aligned_truth
 from rangebearing.core import detect as detect_module
 from rangebearing.core import pipeline as pipeline_module
 from rangebearing.core import uncertainty as u
+from rangebearing.core.limbs import CENTROID_SIGMA_X_PX
 from rangebearing.evaluation.match import match_frame
 from rangebearing.sources.recorded import iter_recorded
 
@@ -56,8 +62,30 @@ BEARING_TERMS = {"column": ("COLUMN_SHARE",), "spread": ("SPREAD_X_SHARE",), "sh
 SPREAD_ARG = 9  # reading_sigma's positional spread_l_px, as the pipeline passes it
 
 
-def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, float, float]]:
-    """``(reading_sigma's arguments, its keywords, true range, true bearing)`` of every matched reading.
+def kind(args: tuple, kwargs: dict) -> str:
+    """The reading's kind: ``cut1``/``cut2`` (cut on one side / both), ``H`` partly hidden, ``M`` a merged
+    band, in that order (``whole``: none of them)."""
+    cut = args[11] if len(args) > 11 else kwargs.get("cut", (False, False))
+    spread = args[SPREAD_ARG] if len(args) > SPREAD_ARG else None
+    label = ("cut2" if all(cut) else "cut1" if any(cut) else "") + ("H" if args[6] < 1.0 else "")
+    label += "M" if isinstance(spread, Spread) and (spread[2] or spread[5]) else ""
+    return label or "whole"
+
+
+def column_source(args: tuple) -> str:
+    """``moments`` when the column is the bands' saturation moments (σ_x their constant), else ``limb``."""
+    return "moments" if args[4] == CENTROID_SIGMA_X_PX else "limb"
+
+
+def seed_of(folder: str) -> str:
+    found = re.search(r"-s(\d+)-", os.path.basename(os.path.normpath(folder)))
+    return found.group(1) if found else os.path.basename(os.path.normpath(folder))
+
+
+def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, float, float, Dict[str, str]]]:
+    """``(reading_sigma's arguments, its keywords, true range, true bearing, labels)`` of every matched reading;
+    the labels (``--split``): the frame ``tracked`` or ``full`` scan, the reading's :func:`kind`, its
+    :func:`column_source`, the folder's seed.
 
     The arguments are kept with the spread's own inputs (``row_spread_px``'s, found by its value)
     in place of ``spread_l_px``, so ``MERGED_PX`` and ``FIT_SPREAD`` are re-evaluated too.
@@ -86,14 +114,16 @@ def replay(folder: str, config: str, tracked: bool) -> List[Tuple[tuple, dict, f
     try:
         for name, image in iter_recorded(folder):
             kept.clear()
-            found = pipe.process(image).landmarks
-            matches, _ = match_frame(name, found, truth.get(name, []))
+            result = pipe.process(image)
+            matches, _ = match_frame(name, result.landmarks, truth.get(name, []))
             for m in matches:
                 if m.found is None:
                     continue
                 for args, kwargs, _out in kept:  # args[0], args[1]: the reading's range and bearing
                     if args[0] == m.found.range_m and args[1] == m.found.bearing_rad:
-                        rows.append((args, kwargs, m.truth.range_m, m.truth.bearing_rad))
+                        labels = {"tracked": "tracked" if result.tracked else "full", "kind": kind(args, kwargs),
+                                  "column": column_source(args), "seed": seed_of(folder)}
+                        rows.append((args, kwargs, m.truth.range_m, m.truth.bearing_rad, labels))
                         break
     finally:
         pipeline_module.reading_sigma = original
@@ -115,17 +145,26 @@ def sigmas(rows: Sequence[tuple], zero: Sequence[str] = ()) -> np.ndarray:
     try:
         for name in zero:
             setattr(u, name, 0.0)
-        return np.array([u.reading_sigma(*_evaluated(args), **kwargs) for args, kwargs, _, _ in rows]).reshape(-1, 2)
+        return np.array([u.reading_sigma(*_evaluated(args), **kwargs) for args, kwargs, *_ in rows]).reshape(-1, 2)
     finally:
         for name, value in saved.items():
             setattr(u, name, value)
 
 
-def report(sets: Dict[str, List[tuple]]) -> None:
-    """Cover, scale for 95 % and the terms' shares of σ², one line per set and quantity."""
+def report(sets: Dict[str, List[tuple]], split: str = "") -> None:
+    """Cover, scale for 95 % and the terms' shares of σ², one line per set and quantity; with ``split`` (a
+    label of :func:`replay`) one line per set and label value, the set's own lines first."""
     for name in sorted(sets):
-        rows = sets[name]
-        err = np.array([[abs(a[0] - tr), abs(a[1] - tb)] for a, _, tr, tb in rows]).reshape(-1, 2)
+        groups = {name: sets[name]}
+        for row in sets[name] if split else ():
+            groups.setdefault(f"{name}/{row[4][split]}", []).append(row)
+        for label in sorted(groups, key=lambda g: (g != name, g)):
+            _report_rows(label, groups[label])
+
+
+def _report_rows(name: str, rows: List[tuple]) -> None:
+    if rows:
+        err = np.array([[abs(a[0] - tr), abs(a[1] - tb)] for a, _, tr, tb, *_ in rows]).reshape(-1, 2)
         s = sigmas(rows)
         z = err / np.maximum(s, 1e-12)
         for k, (label, terms) in enumerate((("range", RANGE_TERMS), ("bearing", BEARING_TERMS))):
@@ -135,7 +174,7 @@ def report(sets: Dict[str, List[tuple]]) -> None:
                 shares.append(f"{term} {np.mean(1.0 - (without / np.maximum(s[:, k], 1e-12)) ** 2):.2f}")
             cover = 100.0 * np.mean(z[:, k] <= 2.0)
             flag = "" if 90.0 <= cover <= 98.0 else " x"
-            print(f"{name:16s} {label:7s} n={len(rows):4d} cover {cover:5.1f} %{flag:2s} scale "
+            print(f"{name:20s} {label:7s} n={len(rows):4d} cover {cover:5.1f} %{flag:2s} scale "
                   f"{np.percentile(z[:, k], 95) / 2:.2f}  shares: {', '.join(shares)}")
 
 
@@ -143,6 +182,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("folders", nargs="+", metavar="SET_DIR[:track]")
     p.add_argument("--config", required=True)
+    p.add_argument("--split", choices=("tracked", "kind", "column", "seed"), default="",
+                   help="also one line per set and frame type / kind of reading / column source / seed")
     p.add_argument("--share", action="append", default=[], metavar="NAME=VALUE",
                    help="recompute the sigmas with this constant of core/uncertainty.py")
     args = p.parse_args(argv)
@@ -158,12 +199,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         base = os.path.basename(os.path.normpath(folder))
         sets[re.sub(r"-s\d+-.*$", "", base)].extend(replay(folder, args.config, mode == "track"))
     print("as configured:")
-    report(sets)
+    report(sets, args.split)
     if changes:
         for name, value in changes.items():
             setattr(u, name, value)
         print("with " + ", ".join(f"{k}={v:g}" for k, v in changes.items()) + ":")
-        report(sets)
+        report(sets, args.split)
     return 0
 
 
