@@ -36,22 +36,23 @@ NOISE_Z, NOISE_CAP = 2.0, 0.35  # ... plus this many standard errors of the two 
 DARK_SHARE = 0.25  # ... in a channel this dark beside the colour's brightest (the noise swamps a few levels)
 OFFSET = 0.01  # linear light added before the log (a black channel's ratio means nothing)
 
-# a colour: linear B, G, R of the median 8-bit colour, and the sorted sampled pixels (for the noise, when asked)
+# a colour: linear B, G, R of the median 8-bit colour, and the sampled pixels, each channel partitioned at its
+# middle two order statistics (for the noise, when asked)
 Colour = Tuple[List[float], np.ndarray]
 
 
 def colour(bgr: np.ndarray, rows: Tuple[float, float], cols: Tuple[float, float]) -> Optional[Colour]:
-    """Linear RGB (B, G, R order) of a region's median 8-bit colour and its sorted samples (``None`` when
-    the region is empty)."""
+    """Linear RGB (B, G, R order) of a region's median 8-bit colour and its samples, partitioned at the
+    median (``None`` when the region is empty)."""
     h, w = bgr.shape[:2]
     r0, r1 = max(0, round(rows[0])), min(h, round(rows[1]) + 1)
     c0, c1 = max(0, round(cols[0])), min(w, round(cols[1]) + 1)
     if r1 <= r0 or c1 <= c0:
         return None
     rs, cs = max(1, (r1 - r0) // SAMPLES), max(1, (c1 - c0) // SAMPLES)
-    # np.median's values from one sort of the few sampled pixels (a third of np.median's cost)
-    sub = np.sort(bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), axis=0)
-    n = sub.shape[0]
+    # np.median's values: the middle order statistics of each channel by one partial sort (a quarter of a full sort)
+    n = len(range(r0, r1, rs)) * len(range(c0, c1, cs))
+    sub = np.partition(bgr[r0:r1:rs, c0:c1:cs].reshape(-1, 3), ((n - 1) // 2, n // 2), axis=0)
     lin = [((lo + hi) / 510.0) ** 2.2 for lo, hi in zip(sub[(n - 1) // 2].tolist(), sub[n // 2].tolist())]
     return lin, sub
 
@@ -66,7 +67,7 @@ def log_error(c: Colour, k: int) -> float:
     lin, sub = c[0][k], c[1][:, k]
     n = len(sub)
     med = 0.5 * (float(sub[(n - 1) // 2]) + float(sub[n // 2]))
-    dev = np.sort(np.abs(sub.astype(np.float64) - med))
+    dev = np.partition(np.abs(sub.astype(np.float64) - med), ((n - 1) // 2, n // 2))
     mad = 0.5 * (dev[(n - 1) // 2] + dev[n // 2])
     se8 = 1.2533 * max(1.4826 * float(mad), 1.0) / math.sqrt(n)
     return 2.2 * lin / (max(med, 0.5) * (lin + OFFSET)) * se8
