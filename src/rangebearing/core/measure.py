@@ -259,12 +259,12 @@ def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
         bled = inner is not None and abs(inner - band.inner) >= BLED_PX
         inner = band.inner if inner is None else inner
         if band.merged:
-            band = dataclasses.replace(band, inner=inner)
+            band = BandEdges(band.centre, inner, True, band.sigma, band.scatter)  # dataclasses.replace, minus its cost
         else:
             outer = 2.0 * band.centre - band.inner
             found = luma_edge(p, outer, not down, band_px, False) if bled else None
             outer = outer if found is None else found
-            band = dataclasses.replace(band, centre=0.5 * (inner + outer), inner=inner)
+            band = BandEdges(0.5 * (inner + outer), inner, False, band.sigma, band.scatter)
         bands.append(band)
     return bands[0], bands[1], bands[1].inner - bands[0].inner
 
@@ -293,7 +293,7 @@ def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     """
     if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
         return blue
-    return dataclasses.replace(blue, merged=True)
+    return BandEdges(blue.centre, blue.inner, True, blue.sigma, blue.scatter)
 
 
 __all__ = ["CENTROID_SIGMA_X_PX", "Rows", "cut_sides", "measure_columns", "measure_rows", "measure_rows_all",
