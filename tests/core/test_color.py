@@ -100,6 +100,7 @@ def test_only_pixels_with_a_channel_at_250_or_more_are_clipped():
 
 @pytest.mark.parametrize("gains", [(1.0, 1.0, 1.0), (1.3, 1.0, 0.8)])
 def test_search_image_class_masks_are_color_class_masks(gains):
+    from rangebearing.core.gain_clip import pushed_over, reclass_pushed
     from rangebearing.core.params import DetectionParams
     from rangebearing.core.search_image import SearchImage
 
@@ -114,4 +115,7 @@ def test_search_image_class_masks_are_color_class_masks(gains):
     for s_min, v_min in ((cfg.s_min, cfg.v_min), (60, 30), (cfg.s_min, cfg.v_min)):  # again: the cached views
         got = img.class_masks(cfg, s_min, v_min)
         want = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, clip)
+        # and the pixels a gain above one pushed to 255 classed by their colour before it (core/gain_clip.py)
+        want = reclass_pushed(*want, small, gains, pushed_over(small, gains, hsv[..., 2]), cfg.red_hue, cfg.blue_hue,
+                              s_min)
         assert all(np.array_equal(g, w) for g, w in zip(got, want))

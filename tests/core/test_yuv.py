@@ -4,6 +4,7 @@ import pytest
 
 from rangebearing.core.color import apply_gains, class_masks, grey_world_gains, to_hsv
 from rangebearing.core.detect import _clipped, downscale
+from rangebearing.core.gain_clip import pushed_over, reclass_pushed
 from rangebearing.core.params import DetectionParams
 from rangebearing.core.yuv import (
     BLUE,
@@ -176,8 +177,10 @@ def test_masks_and_gains_match_the_bgr_path_on_a_rendered_frame():
 
 def _bgr_path_masks(small, gains):
     """The BGR path's unfiltered masks with its clipped rules (pixels clipped before the gains included)."""
-    return class_masks(to_hsv(apply_gains(small, gains)), DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min,
-                       _clipped(small, gains))
+    hsv = to_hsv(apply_gains(small, gains))
+    masks = class_masks(hsv, DET.red_hue, DET.blue_hue, DET.s_min, DET.v_min, _clipped(small, gains))
+    return reclass_pushed(*masks, small, gains, pushed_over(small, gains, hsv[..., 2]), DET.red_hue, DET.blue_hue,
+                          DET.s_min)
 
 
 def test_clipped_colours_of_a_grid_classify_as_the_bgr_path_does():

@@ -31,6 +31,7 @@ from .blobs import mask_centroid
 from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, relaxed_floors, to_hsv
 from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, median_filter, none_apart_filtered
+from .gain_clip import pushed_over, reclass_pushed
 from .limbs import whole_centre
 from .measure import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
@@ -84,6 +85,8 @@ def region_masks(small: np.ndarray, cfg: DetectionParams, gains: Gains, ksize: i
     """Filtered red and blue masks of a downscaled frame: balance, HSV, thresholds, majority filter."""
     hsv = to_hsv(apply_gains(small, gains))
     red, blue = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, _clipped(small, gains))
+    red, blue = reclass_pushed(red, blue, small, gains, pushed_over(small, gains, hsv[..., 2]), cfg.red_hue,
+                               cfg.blue_hue, cfg.s_min)
     return band_masks(red, blue, ksize)
 
 

@@ -15,13 +15,14 @@ import cv2
 import numpy as np
 
 from .color import Gains, apply_gains, class_hues, clip_of, clipped_mask, sv_gate, to_hsv
+from .gain_clip import pushed_over, reclass_pushed
 from .params import DetectionParams
 
 
 class SearchImage:
     """The views of one downscaled BGR frame (``small``, uint8) under ``gains``, made on first use."""
 
-    __slots__ = ("_clipped", "_hsv_split", "_hues", "gains", "hsv", "small")
+    __slots__ = ("_clipped", "_hsv_split", "_hues", "_pushed", "gains", "hsv", "small")
 
     def __init__(self, small: np.ndarray, gains: Gains) -> None:
         self.small, self.gains = small, gains
@@ -29,6 +30,7 @@ class SearchImage:
         self._hsv_split: Optional[Tuple[np.ndarray, ...]] = None
         self._hues: Dict[tuple, Tuple[np.ndarray, np.ndarray]] = {}  # the hue masks by the ranges they are of
         self._clipped: Optional[Tuple[Optional[np.ndarray]]] = None
+        self._pushed: Optional[tuple] = None  # (gain_clip.pushed_over,) once made
 
     def clipped(self) -> Optional[np.ndarray]:
         """Pixels clipped before the gains, when a gain below one may have hidden it (else ``None``)."""
@@ -46,4 +48,7 @@ class SearchImage:
             self._hues[key] = class_hues(h, cfg.red_hue, cfg.blue_hue, clip_of(s, v, self.clipped()))
         red_h, blue_h = self._hues[key]
         sv = sv_gate(s, v, s_min, v_min, self.clipped())
-        return cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv)
+        if self._pushed is None:
+            self._pushed = (pushed_over(self.small, self.gains, v),)
+        return reclass_pushed(cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv), self.small, self.gains,
+                              self._pushed[0], cfg.red_hue, cfg.blue_hue, s_min)

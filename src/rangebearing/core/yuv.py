@@ -33,6 +33,7 @@ from .._compat import frozen
 from .color import UNIT_GAINS, Gains, class_masks, clipped_mask, grey_world_gains, relaxed_floors, to_hsv
 from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, none_apart_filtered
+from .gain_clip import pushed_over, reclass_pushed
 from .params import DetectionParams
 from .structure import Found, search, search_apart
 from .types import LandmarkGeometry
@@ -196,8 +197,9 @@ def _saturated(red: np.ndarray, blue: np.ndarray, where: Tuple[np.ndarray, np.nd
     y, u, v = (p[where].reshape(-1, 1) for p in planes)
     raw = yuv_to_bgr(y, u, v, colour_space)
     clipped = clipped_mask(raw) if min(gains) < 0.98 else None
-    r, b = class_masks(to_hsv(yuv_to_bgr(y, u, v, colour_space, gains)), cfg.red_hue, cfg.blue_hue, cfg.s_min,
-                       cfg.v_min, clipped)
+    hsv = to_hsv(yuv_to_bgr(y, u, v, colour_space, gains))
+    r, b = class_masks(hsv, cfg.red_hue, cfg.blue_hue, cfg.s_min, cfg.v_min, clipped)
+    r, b = reclass_pushed(r, b, raw, gains, pushed_over(raw, gains, hsv[..., 2]), cfg.red_hue, cfg.blue_hue, cfg.s_min)
     red[where], blue[where] = r[:, 0], b[:, 0]
 
 
