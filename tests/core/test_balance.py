@@ -204,6 +204,11 @@ def test_the_second_look_adds_only_landmarks_apart_from_those_found():
     striped = dataclasses.replace(striped, cut_left=True, cut_right=True)  # stripes run on beyond both sides
     one_side = dataclasses.replace(cand(130), cut_left=True)  # a real landmark beside a neighbour
     assert second_look(found, [touching, apart, striped, one_side]) == [apart, one_side]
+    # before a wall of its blue band's colour: cut on both sides, but its red band ends at both limbs
+    walled = dataclasses.replace(striped, band_ends=(True, True))
+    assert second_look(found, [walled, dataclasses.replace(walled, band_ends=(True, False))]) == [walled]
+    assert second_look([], [dataclasses.replace(walled, red_bbox_px=(0, 40, 20, 8))], 160) == []  # frame's edge
+    assert second_look(found, [dataclasses.replace(walled, visible=0.75)]) == []  # narrower than its limbs
 
 
 def test_the_second_look_takes_the_frames_edge_for_a_cut_side():

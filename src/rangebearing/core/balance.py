@@ -24,6 +24,7 @@ statistics, but both leave a landmark findable under one of the two. So:
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -39,6 +40,7 @@ TALLER = 1.15  # of one landmark found twice, a white body this much taller is t
 STRONG_CAST = 0.15  # a gain more than 15 % from one: the halfway balance is searched too
 MIN_WHITE_PX = 12  # unclipped, not dark pixels of white body needed for a landmark to vote
 SAMPLES = 16  # rows and columns sampled per white body (the median needs no more)
+WHOLE = 0.9  # a second-look candidate cut on both sides shows both limbs of a band: as wide as a silhouette
 
 
 def near_unit(gains: Gains, tol: float = NEAR_UNIT) -> bool:
@@ -227,8 +229,17 @@ def second_look(found: Sequence[Candidate], more: Sequence[Candidate], frame_w_p
     is cut there (:func:`.limbs.cut_sides`).
     """
     boxes = [_box(c) for c in found]
-    return [c for c in more if not all(cut_sides(c, frame_w_px) if frame_w_px else (c.cut_left, c.cut_right))
-            and not any(_meet(_box(c), b) for b in boxes)]
+    return [c for c in more if _limb_shown(c, frame_w_px) and not any(_meet(_box(c), b) for b in boxes)]
+
+
+def _limb_shown(c: Candidate, frame_w_px: Optional[int]) -> bool:
+    """Whether a second-look candidate shows the cylinder's outline: a side where neither band runs on, or,
+    inside the frame, on each side one band that ends (a landmark before a wall of its other band's colour:
+    the red bands before a blue wall end at the limbs; a background's stripes run on in both colours)."""
+    if not all(cut_sides(c, frame_w_px) if frame_w_px else (c.cut_left, c.cut_right)):
+        return True
+    inside = not frame_w_px or not any(cut_sides(dataclasses.replace(c, cut_left=False, cut_right=False), frame_w_px))
+    return inside and all(c.band_ends) and c.visible >= WHOLE  # both limbs of a band: the whole silhouette
 
 
 def _box(c: Candidate) -> Box:

@@ -33,7 +33,7 @@ import numpy as np
 from .._compat import frozen
 from .behind import occluded_sides, without_nearer
 from .color import RELAXED_WHITE_V
-from .columns import WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
+from .columns import WHITE_S_MAX, WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .denoise import both_outside
 from .fragments import MIN_PIECE, Fragment, extend_along_bands, join_fragments, lit_like_bands, split_runs
 from .regions import MAX_REGIONS, band_regions, outside, partnered, region_stats  # noqa: F401  (region cap there)
@@ -71,6 +71,8 @@ class Candidate:
     hidden_band: str = ""  # "red"/"blue": seen in fewer of the columns (partly hidden), its moments no column cue
     body_cols_px: Optional[Tuple[int, int]] = None  # [x0, x1) where the white body shows, when only part of it does
     occluded: str = ""  # "left"/"right": a nearer landmark stands right beside it there and hides that side
+    # (left, right): a band ends there, though the other runs on, and no pale thing runs on beside the body
+    band_ends: Tuple[bool, bool] = (False, False)
 
 
 def _pairable(reds: np.ndarray, blues: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -111,6 +113,15 @@ def _continues(mask: np.ndarray, rows: Tuple[int, int], col: int) -> bool:
         return False
     seg = mask[max(0, rows[0]) : max(0, rows[1]), col]
     return seg.size > 0 and 255 * np.count_nonzero(seg) > 127 * seg.size  # mean > 127 of a 0/255 mask
+
+
+def _white_on(hsv: np.ndarray, rows: Tuple[int, int], col: int, v_min: int) -> bool:
+    """Whether the white body's class (S < ``WHITE_S_MAX``, V ≥ ``v_min``) mostly fills ``rows`` of column
+    ``col`` of ``hsv``: a pale thing (a skirting board) runs on beside the body; outside the image: no."""
+    if col < 0 or col >= hsv.shape[1]:
+        return False
+    seg = hsv[max(0, rows[0]) : max(0, rows[1]), col]
+    return seg.size > 0 and 2 * int(np.count_nonzero((seg[:, 1] < WHITE_S_MAX) & (seg[:, 2] >= v_min))) > len(seg)
 
 
 def search(
@@ -250,9 +261,13 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
         reach = 1 + round(0.08 * w_exp)
         for q, (p0, p1) in enumerate(pieces):
             c0, c1 = round(p0), round(p1)
-            left = q > 0 or ext_l or _continues(red, rrows, c0 - reach) or _continues(blue, brows, c0 - reach)
-            right = (q < len(pieces) - 1 or ext_r or _continues(red, rrows, c1 - 1 + reach)
-                     or _continues(blue, brows, c1 - 1 + reach))
+            on_l = (_continues(red, rrows, c0 - reach), _continues(blue, brows, c0 - reach))
+            on_r = (_continues(red, rrows, c1 - 1 + reach), _continues(blue, brows, c1 - 1 + reach))
+            left, right = q > 0 or ext_l or any(on_l), q < len(pieces) - 1 or ext_r or any(on_r)
+            body_rows = (int(ey1) + 1, int(ey2))
+            band_ends = (not (q > 0 or ext_l or all(on_l) or _white_on(hsv, body_rows, c0 - reach, white_v_min)),
+                         not (q < len(pieces) - 1 or ext_r or all(on_r)
+                              or _white_on(hsv, body_rows, c1 - 1 + reach, white_v_min)))
             rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
             bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
             if any(_overlaps(rb, t) for t in taken):
@@ -261,7 +276,8 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
             # the pattern fails in about one column at the limbs together (mixed pixels): count it back
             vis = min(seen, (p1 - p0 + 1) / w_exp) if len(pieces) == 1 else 1.0
             body = None if seen == 1.0 else (int(frag[0]) * scale, int(frag[1]) * scale)
-            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis, hidden, body))
+            out.append(Candidate(rb, bb, gap * scale, red_merged, blue_merged, left, right, vis, hidden, body,
+                                 band_ends=band_ends))
             if len(out) >= max_landmarks:
                 return occluded_sides(out, scale)
     return occluded_sides(out, scale)
