@@ -120,7 +120,7 @@ def _white_on(hsv: np.ndarray, rows: Tuple[int, int], col: int, v_min: int) -> b
     ``col`` of ``hsv``: a pale thing (a skirting board) runs on beside the body; outside the image: no."""
     if col < 0 or col >= hsv.shape[1]:
         return False
-    seg = hsv[max(0, rows[0]) : max(0, rows[1]), col]
+    seg = hsv[max(0, rows[0]) : max(0, rows[1]), col : col + 1].reshape(-1, 3)  # two slices: the YUV path's view
     return seg.size > 0 and 2 * int(np.count_nonzero((seg[:, 1] < WHITE_S_MAX) & (seg[:, 2] >= v_min))) > len(seg)
 
 
