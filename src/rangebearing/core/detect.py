@@ -7,15 +7,13 @@ Fast path (default)::
     → connected regions → pairing → sub-pixel moments on the *unfiltered*
       full-resolution pixels inside each paired band
 
-The filter decides *where* the bands are; the moments of the original pixels
-decide *exactly where*: a median over the colour image rounds the band corners
-and moves the centroids, which costs range accuracy.
+The filter decides *where* the bands are; the moments of the original pixels decide *exactly
+where*: a median over the colour image rounds the band corners and moves the centroids, which costs range accuracy.
 
 Paper path: median filter over the whole colour frame, HSV, thresholds, and
 the moments of the whole red and blue masks — one landmark at most.
 
-Between full scans, :mod:`rangebearing.core.tracking` measures known landmarks
-in place instead.
+Between full scans, :mod:`rangebearing.core.tracking` measures known landmarks in place instead.
 """
 
 from __future__ import annotations
