@@ -50,8 +50,8 @@ class Recorder:
                                  [verify.rejection(bgr, c, geometry, model, cam, found) for c in found])
         return self._verified(bgr, found, geometry, model, cam)
 
-    def drop_stacked(self, found):
-        out = self._stacked(found)
+    def drop_stacked(self, found, **kw):
+        out = self._stacked(found, **kw)
         self.stage["stacked"] = [c for c in found if c not in out]
         return out
 

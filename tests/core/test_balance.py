@@ -254,3 +254,23 @@ def test_a_frame_two_and_a_half_stops_under_is_found_by_the_second_look():
     (lm,) = Pipeline(params, track=False).process(dark).landmarks
     assert lm.range_m == pytest.approx(0.9, rel=0.01)
     assert abs(lm.bearing_rad - 0.05) < math.radians(0.15)
+
+
+def test_a_cut_side_of_a_nearer_landmark_hides_its_whole_silhouette():
+    import dataclasses
+
+    from rangebearing.core.detect import drop_stacked
+    from rangebearing.core.structure import Candidate
+
+    # a near landmark (spacing 110: 70 px wide, columns 65-135) whose left part a mast in front hides:
+    # its run and box start at column 100, but its axis is still at 100
+    near = bands(100, 50, spacing=110.0, w=70)
+    box_r, box_b = (100, 45, 35, 10), (100, 155, 35, 10)
+    cut = Candidate(box_r, box_b, 80.0, False, False, True, False, 0.5)
+    near = dataclasses.replace(near, red_bbox_px=box_r, blue_bbox_px=box_b, candidate=cut)
+    # the mast under its camera board before its body, read as a far landmark left of its box
+    behind = bands(90, 80, spacing=20.0, w=8)
+    assert drop_stacked([near, behind]) == [near]
+    # seen whole (not cut), the same box hides nothing left of it
+    whole = dataclasses.replace(near, candidate=dataclasses.replace(cut, cut_left=False))
+    assert drop_stacked([whole, behind]) == [whole, behind]

@@ -262,7 +262,15 @@ def _share_inside(c: BBox, o: BBox) -> float:
     return max(0, w) * max(0, h) / max(1, c[2] * c[3])
 
 
-def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
+def _silhouette(c: BandCentroids, l_px: float, aspect: float, frame_w: float) -> BBox:
+    """``c``'s box; cut on one side only, the whole silhouette (``aspect`` × spacing) from its limb on the other."""
+    (x, y, w, h), cd, full = c.bbox_px, c.candidate, aspect * l_px
+    if cd is None or cd.cut_left == cd.cut_right or w >= full or x <= 0 or x + w >= frame_w - 1:
+        return c.bbox_px  # seen whole, cut on both sides, or at the frame's edge: no limb to measure from
+    return (x + w - full, y, full, h) if cd.cut_left else (x, y, full, h)
+
+
+def drop_stacked(found: Sequence[BandCentroids], aspect: float = 35 / 55, frame_w: float = 1e9) -> List[BandCentroids]:
     """Drop every landmark that stands wholly below another of its size or larger, nearby in the image,
     or that lies inside the silhouette of a clearly nearer one.
 
@@ -272,11 +280,10 @@ def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
     robot under the upper one read as one (its red top plate, a pale bumper, a
     blue floor in front: a red–white–blue column of the right proportions).
 
-    A nearer landmark hides everything behind it, so nothing farther can be
-    seen inside its silhouette (its red top to its blue bottom, its columns):
-    a small "landmark" there is made of the nearer one's own parts (the top
-    of its red band over its body over its robot's camera board in front, read
-    as a far landmark's red, white and blue).
+    A nearer landmark hides everything behind it, so nothing farther can be seen inside its silhouette
+    (its red top to its blue bottom, its columns; cut on one side, ``aspect`` × its spacing from its limb):
+    a small "landmark" there is made of the nearer one's own parts (the top of its red band over its body
+    over its robot's camera board in front, or a mast before it, read as a far landmark's red, white, blue).
     """
     # each landmark's spacing, box and width once (properties), then the pairs on plain tuples
     facts = [(c, c.blue_xy_px[1] - c.red_xy_px[1], c.bbox_px, c.width_px) for c in found]
@@ -292,7 +299,7 @@ def drop_stacked(found: Sequence[BandCentroids]) -> List[BandCentroids]:
         inside = any(
             o is not c
             and NEST_SIZE * l_c <= l_o
-            and _share_inside(box_c, box_o) >= NEST_SHARE
+            and _share_inside(box_c, _silhouette(o, l_o, aspect, frame_w)) >= NEST_SHARE
             for o, l_o, box_o, _ in facts
         )
         if not (below or inside):

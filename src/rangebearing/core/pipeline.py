@@ -185,7 +185,7 @@ class Pipeline:
                 found = refine(bgr, cands, det, self._gains, self.params.landmark, cam.fy_px, pyramid)
                 # no landmark without a landmark's properties, nor away from where landmarks stand
                 found = verified(bgr, found, self.params.landmark, self.params.model, cam)
-                found = drop_stacked(found)  # nor one standing under another (that robot's body)
+                found = drop_stacked(found, frame_w=bgr.shape[1])  # nor one standing under another (that robot's body)
                 # the colour's blur, of all landmarks at once; tracked frames keep it (see _reading)
                 blurs = chroma_blur_all(bgr, [(c.red_xy_px, c.blue_xy_px, c.width_px) for c in found], self._gains)
                 found = [dataclasses.replace(c, chroma_blur_px=b) for c, b in zip(found, blurs)]
