@@ -11,7 +11,7 @@ matches its readings to the truth as ``replay --truth`` does. For every reading 
 ``cL``/``cR`` cut side, ``wh`` the white height the structure search found) and the nearest truth
 landmark by bearing. ``DROPPED`` lines name the real landmarks (missed, within 3 deg and half the
 range of a candidate) that verification (:mod:`rangebearing.core.verify`) or
-:func:`rangebearing.core.detect.drop_stacked` rejected, with the reason; ``--misses`` also lists
+:func:`rangebearing.core.stacked.drop_stacked` rejected, with the reason; ``--misses`` also lists
 every findable landmark missed. The last line per set counts frames, false readings (and those
 on frames without a landmark) and real landmarks dropped.
 """

@@ -129,7 +129,7 @@ def bands(x, y, spacing=40.0, w=20):
 
 
 def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
-    from rangebearing.core.detect import drop_stacked
+    from rangebearing.core.stacked import drop_stacked
 
     top, plate = bands(100, 50), bands(110, 110)  # the robot's red plate, bumper and blue floor below
     assert drop_stacked([top, plate]) == [top]
@@ -144,7 +144,7 @@ def test_a_landmark_wholly_below_another_of_its_size_is_the_robot_under_it():
 
 
 def test_nothing_farther_shows_inside_a_nearer_landmarks_silhouette():
-    from rangebearing.core.detect import drop_stacked
+    from rangebearing.core.stacked import drop_stacked
 
     near = bands(100, 50, spacing=60.0, w=30)  # rows 45-115, columns 85-115
     # its red band's top over its body over its own camera board, read as a far landmark
@@ -259,7 +259,7 @@ def test_a_frame_two_and_a_half_stops_under_is_found_by_the_second_look():
 def test_a_cut_side_of_a_nearer_landmark_hides_its_whole_silhouette():
     import dataclasses
 
-    from rangebearing.core.detect import drop_stacked
+    from rangebearing.core.stacked import drop_stacked
     from rangebearing.core.structure import Candidate
 
     # a near landmark (spacing 110: 70 px wide, columns 65-135) whose left part a mast in front hides:

@@ -22,7 +22,7 @@ import numpy as np
 from .balance import balanced_search
 from .color import UNIT_GAINS, Gains, grey_world_gains
 from .denoise import Box, band_preserving_ksize
-from .detect import BandCentroids, detect_paper, downscale, drop_stacked, refine, search_candidates
+from .detect import BandCentroids, detect_paper, downscale, refine, search_candidates
 from .hidden import Hidden, still_hidden, tracks_of
 from .identity import IdentityState, empty_state, update
 from .limbs import cut_sides
@@ -33,6 +33,7 @@ from .params import PipelineParams
 from .refine import Pyramid
 from .scans import Cadence, crossing, periodic, rescanned, scan_due
 from .search_image import SearchImage
+from .stacked import drop_stacked
 from .structure import Found
 from .tracking import Track, step
 from .types import CameraIntrinsics, FrameResult, Landmark, check_frame
