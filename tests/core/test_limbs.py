@@ -167,29 +167,3 @@ def test_a_mast_in_front_of_one_band_does_not_end_the_other_bands_limb():
     img = np.round(255.0 * lin ** (1 / 2.2)).astype(np.uint8)
     x, _ = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
     assert x == pytest.approx(_centre(74.3, True), abs=0.05)
-
-
-def _whole(x0, x1):
-    return Candidate((x0, 20, x1 - x0, 15), (x0, 76, x1 - x0, 15), 40.0, False, False, False, False, 1.0)
-
-
-def test_a_whole_landmark_is_placed_at_its_limbs_midpoint_whatever_skews_its_colour_inside():
-    from rangebearing.core.limbs import whole_centre
-
-    half = ROWS.white_px * GEOMETRY.radius_m / (GEOMETRY.height_m - 2 * GEOMETRY.band_height_m)
-    half *= 1.0 - GEOMETRY.radius_m / (F_PX * 0.04 / ROWS.white_px + GEOMETRY.radius_m)
-    x0 = 40.3
-    img = _frame(x0, x0 + 2 * half)
-    # a glossy streak right of the axis: the bands' columns 62-65 washed towards white (the moments move left)
-    img[20:35, 62:66] = (150, 150, 255)
-    img[76:90, 62:66] = (255, 150, 150)
-    x = whole_centre(img, _whole(40, round(x0 + 2 * half)), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
-    assert x == pytest.approx(x0 + half, abs=0.05)
-
-
-def test_a_whole_landmark_whose_limbs_are_no_outline_apart_keeps_its_moments():
-    from rangebearing.core.limbs import whole_centre
-
-    # a red-and-blue thing 24 px wide where the white body says 34: no outline of this landmark
-    img = _frame(40.3, 64.3)
-    assert whole_centre(img, _whole(40, 64), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS) is None

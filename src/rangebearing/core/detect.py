@@ -30,7 +30,6 @@ from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, rela
 from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, median_filter, none_apart_filtered
 from .gain_clip import pushed_over, reclass_pushed
-from .limbs import whole_centre
 from .measure import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
@@ -200,11 +199,6 @@ def combine(
         x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
         if c.hidden_band:  # a partly hidden band's moments are pulled off the axis: the whole one places both
             x_r = x_b = x_b if c.hidden_band == "red" else x_r
-        else:  # cut on neither side: the limbs' midpoint places it; the bands keep their difference (its σ)
-            mid = whole_centre(bgr, c, gains, geometry, fy_px, rows)
-            if mid is not None:
-                shift = mid - 0.5 * (x_r + x_b)
-                x_r, x_b = x_r + shift, x_b + shift
     else:
         x_r = x_b = cols[0]
         sx = cols[1]

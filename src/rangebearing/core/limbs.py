@@ -132,45 +132,19 @@ def measure_columns(
     return x, LIMB_SIGMA_X_PX
 
 
-def whole_centre(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGeometry, fy_px: float,
-                 rows: Rows) -> Optional[float]:
-    """The outline's centre column of a landmark cut on neither side, from its two limbs; ``None``: no such pair.
-
-    Saturation moments weigh every column by its colour, so whatever skews the colour across the
-    cylinder moves them: a specular streak off its axis, glossy paint's Fresnel sheen, shading, a
-    colour fringe. The limbs are where the band ends against its background, whatever lies between.
-    Both must be found and lie a whole outline apart (``WHOLE_WIDTH``): a limb widened by a
-    same-coloured background or cut short by something in front leaves the moments.
-    """
-    white_m = geometry.height_m - 2 * geometry.band_height_m
-    d = fy_px * white_m / max(rows.white_px, 1e-3) + geometry.radius_m
-    half = rows.white_px * geometry.radius_m / white_m * (1.0 - geometry.radius_m / d)
-    edge_r, edge_l = _limb_edges(bgr, c, gains, geometry, rows, half, (True, False))
-    if edge_r is None or edge_l is None or abs((edge_r - edge_l) / max(2 * half, 1e-6) - 1.0) > WHOLE_WIDTH:
-        return None
-    return 0.5 * (edge_l + edge_r)
-
-
 def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGeometry, rows: Rows,
                half: float, right: bool) -> Optional[float]:
     """The column of the candidate's right (``right``) or left limb from both bands' limbs, or ``None``."""
-    return _limb_edges(bgr, c, gains, geometry, rows, half, (right,))[0]
-
-
-def _limb_edges(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGeometry, rows: Rows,
-                half: float, sides: Tuple[bool, ...]) -> Tuple[Optional[float], ...]:
-    """:func:`_limb_edge` of each side in ``sides`` (``True``: right), each band's profile read once for all."""
     white_m = geometry.height_m - 2 * geometry.band_height_m
     band_px = rows.white_px * geometry.band_height_m / white_m
     rx, _, rw, _ = c.red_bbox_px
     reach = round(2 * half) + 4
-    edges: Tuple[list, ...] = tuple([] for _ in sides)
-    x0 = rx - 4 if sides == (True,) else rx - reach
-    x1 = rx + rw + 4 if sides == (False,) else rx + rw + reach
+    edges = []
     for y_c, is_red in ((rows.red_y_px, True), (rows.blue_y_px, False)):
         if c.hidden_band == ("red" if is_red else "blue"):  # partly hidden (its robot's mast): its limb may be the mast
             continue
         y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
+        x0, x1 = (rx - 4, rx + rw + reach) if right else (rx - reach, rx + rw + 4)
         tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=thin_step(y1 - y0))
         er, eb = excess(tile, gains)
         lin_sum = np.maximum(linear_table()[tile].sum(axis=2), 1e-3)
@@ -179,20 +153,14 @@ def _limb_edges(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkG
         n = len(q)
         if n < 4:
             continue
+        if right:  # start inside, run right
+            core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
+        else:
+            core = max(0, min(n - 1, int(rx - ox) + int(half)))
+        level = median(q[max(0, core - 2) : core + 3])
         mix = (ex.mean(axis=0), lin_sum.mean(axis=0))  # the coverage from the mixture (edges.limb)
-        for found, right in zip(edges, sides):
-            if right:  # start inside, run right
-                core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
-            else:
-                core = max(0, min(n - 1, int(rx - ox) + int(half)))
-            level = median(q[max(0, core - 2) : core + 3])
-            found.append(ox + limb(q, core, n - 1 if right else 0, level, mix))
-    return tuple(_side_limb([e for e in found if math.isfinite(e)], rx + rw if right else rx, half, right)
-                 for found, right in zip(edges, sides))
-
-
-def _side_limb(edges: list, run_end: int, half: float, right: bool) -> Optional[float]:
-    """One side's limb from the bands' limbs found there (:func:`_limb_edge`)."""
+        edges.append(ox + limb(q, core, n - 1 if right else 0, level, mix))
+    edges = [e for e in edges if math.isfinite(e)]
     if not edges:
         return None
     if len(edges) == 2 and abs(edges[0] - edges[1]) <= LIMB_AGREE_PX:
@@ -200,6 +168,7 @@ def _side_limb(edges: list, run_end: int, half: float, right: bool) -> Optional[
     # apart: a same-coloured background widened one band (the inner limb is the cylinder's), or a thing in front of
     # one (its robot's mast across the blue band) ended it short of the limb; only the limb ending the run the
     # structure search saw on this side (red over white over blue) can be the cylinder's
+    run_end = rx + rw if right else rx
     at_end = [e for e in edges if abs(e - run_end) <= RUN_END_PX + RUN_END_SHARE * 2 * half]
     if len(edges) == 2 and len(at_end) == 1:
         return at_end[0]
