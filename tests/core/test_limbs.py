@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rangebearing.core.limb_edge import limb
-from rangebearing.core.limbs import measure_columns, outline_centre
+from rangebearing.core.limbs import at_frame_edges, cut_sides, measure_columns, outline_centre
 from rangebearing.core.measure import Rows
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
@@ -167,3 +167,13 @@ def test_a_mast_in_front_of_one_band_does_not_end_the_other_bands_limb():
     img = np.round(255.0 * lin ** (1 / 2.2)).astype(np.uint8)
     x, _ = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
     assert x == pytest.approx(_centre(74.3, True), abs=0.05)
+
+
+def test_the_frame_edges_cut_a_side_whatever_the_search_saw() -> None:
+    inside = Candidate((100, 40, 20, 8), (100, 80, 20, 8), 30.0, False, False, False, False, 1.0)
+    at_left = Candidate((0, 40, 20, 8), (0, 80, 20, 8), 30.0, False, False, False, True, 1.0)
+    at_right = Candidate((300, 40, 20, 8), (300, 80, 20, 8), 30.0, False, False, False, False, 1.0)
+    assert at_frame_edges(inside, 320) == (False, False)
+    assert at_frame_edges(at_left, 320) == (True, False)  # the structure's own right cut is not an edge
+    assert at_frame_edges(at_right, 320) == (False, True)
+    assert cut_sides(at_left, 320) == (True, True)  # the edge and the structure's cut together

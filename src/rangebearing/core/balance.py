@@ -24,14 +24,13 @@ statistics, but both leave a landmark findable under one of the two. So:
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from .color import CLIPPED, DARK, UNIT_GAINS, Gains
 from .denoise import Box
-from .limbs import cut_sides
+from .limbs import at_frame_edges, cut_sides
 from .stats import median_rows
 from .structure import Candidate, Found
 
@@ -238,7 +237,7 @@ def _limb_shown(c: Candidate, frame_w_px: Optional[int]) -> bool:
     the red bands before a blue wall end at the limbs; a background's stripes run on in both colours)."""
     if not all(cut_sides(c, frame_w_px) if frame_w_px else (c.cut_left, c.cut_right)):
         return True
-    inside = not frame_w_px or not any(cut_sides(dataclasses.replace(c, cut_left=False, cut_right=False), frame_w_px))
+    inside = not frame_w_px or not any(at_frame_edges(c, frame_w_px))
     return inside and all(c.band_ends) and c.visible >= WHOLE  # both limbs of a band: the whole silhouette
 
 

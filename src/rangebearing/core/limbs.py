@@ -55,8 +55,14 @@ def cut_sides(c: Candidate, frame_w_px: int) -> Tuple[bool, bool]:
     neighbour), the frame's own edge cuts a landmark: the moments of what is
     left would place it towards the inside, by up to half a silhouette.
     """
+    left, right = at_frame_edges(c, frame_w_px)
+    return c.cut_left or left, c.cut_right or right
+
+
+def at_frame_edges(c: Candidate, frame_w_px: int) -> Tuple[bool, bool]:
+    """``(left, right)``: sides of the candidate that touch the frame's edge (within ``FRAME_EDGE_PX``)."""
     rx, _, rw, _ = c.red_bbox_px
-    return c.cut_left or rx <= FRAME_EDGE_PX, c.cut_right or rx + rw >= frame_w_px - FRAME_EDGE_PX
+    return rx <= FRAME_EDGE_PX, rx + rw >= frame_w_px - FRAME_EDGE_PX
 
 
 def thin_step(n: int) -> int:

@@ -62,7 +62,7 @@ def drop_stacked(found: Sequence[BandCentroids], aspect: float = 35 / 55, frame_
             o is not c
             and NEST_SIZE * l_c <= l_o
             and _share_inside(box_c, _silhouette(o, l_o, aspect, frame_w)) >= NEST_SHARE
-            for o, l_o, box_o, _ in facts
+            for o, l_o, _, _ in facts
         )
         if not (below or inside):
             out.append(c)

@@ -263,11 +263,11 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
             c0, c1 = round(p0), round(p1)
             on_l = (_continues(red, rrows, c0 - reach), _continues(blue, brows, c0 - reach))
             on_r = (_continues(red, rrows, c1 - 1 + reach), _continues(blue, brows, c1 - 1 + reach))
-            left, right = q > 0 or ext_l or any(on_l), q < len(pieces) - 1 or ext_r or any(on_r)
+            inner_l, inner_r = q > 0 or ext_l, q < len(pieces) - 1 or ext_r  # cut by a split or an extension
+            left, right = inner_l or any(on_l), inner_r or any(on_r)
             body_rows = (int(ey1) + 1, int(ey2))
-            band_ends = (not (q > 0 or ext_l or all(on_l) or _white_on(hsv, body_rows, c0 - reach, white_v_min)),
-                         not (q < len(pieces) - 1 or ext_r or all(on_r)
-                              or _white_on(hsv, body_rows, c1 - 1 + reach, white_v_min)))
+            band_ends = (not (inner_l or all(on_l) or _white_on(hsv, body_rows, c0 - reach, white_v_min)),
+                         not (inner_r or all(on_r) or _white_on(hsv, body_rows, c1 - 1 + reach, white_v_min)))
             rb = (c0 * scale, rrows[0] * scale, (c1 - c0) * scale, (rrows[1] - rrows[0]) * scale)
             bb = (c0 * scale, brows[0] * scale, (c1 - c0) * scale, (brows[1] - brows[0]) * scale)
             if any(_overlaps(rb, t) for t in taken):
