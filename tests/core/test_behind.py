@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from rangebearing.core.behind import without_nearer
+from rangebearing.core.behind import NearerCleared, without_nearer
 from rangebearing.core.fragments import extend_along_bands
 from rangebearing.core.structure import Candidate
 
@@ -17,6 +17,20 @@ def test_the_nearer_candidates_boxes_are_cleared_and_the_masks_kept():
     assert r[4, 10:20].all() and r[5:29, 9].all() and r[5:29, 20].all()
     assert red.all() and blue.all()  # the caller's masks untouched
     assert without_nearer(red, blue, [], 2) == (red, blue)
+
+
+def test_nearer_cleared_gives_without_nearers_masks_as_the_list_grows():
+    rng = np.random.default_rng(29001)
+    red, blue = (rng.integers(0, 2, (60, 80), np.uint8) * 255 for _ in range(2))
+    red0, blue0 = red.copy(), blue.copy()
+    cands = [Candidate((2 * x, 2 * y, 14, 6), (2 * x, 2 * y + 30, 14, 6), 24.0, False, False, False, False, 1.0)
+             for x, y in ((3, 2), (20, 10), (31, 30), (5, 40))]
+    cleared = NearerCleared(red, blue, 2)
+    assert cleared.masks([]) == (red, blue)  # nothing nearer: the masks themselves
+    for k in (1, 1, 2, 4):
+        got, want = cleared.masks(cands[:k]), without_nearer(red, blue, cands[:k], 2)
+        assert all(np.array_equal(g, w) for g, w in zip(got, want))
+    assert np.array_equal(red, red0) and np.array_equal(blue, blue0)  # the caller's masks untouched
 
 
 def test_a_band_running_on_into_a_nearer_landmarks_band_ends_at_its_limb():

@@ -28,13 +28,37 @@ def without_nearer(
     if not nearer:
         return red, blue
     red, blue = red.copy(), blue.copy()
+    _clear(red, blue, nearer, scale)
+    return red, blue
+
+
+def _clear(red: np.ndarray, blue: np.ndarray, nearer: Sequence[Candidate], scale: int) -> None:
+    """Clear the boxes of ``nearer`` in ``red`` and ``blue``, in place."""
     for c in nearer:
         x0, y0 = c.red_bbox_px[0] // scale, c.red_bbox_px[1] // scale
         x1 = -(-(c.red_bbox_px[0] + c.red_bbox_px[2]) // scale)
         y1 = -(-(c.blue_bbox_px[1] + c.blue_bbox_px[3]) // scale)
         red[max(0, y0) : max(0, y1), max(0, x0) : max(0, x1)] = 0
         blue[max(0, y0) : max(0, y1), max(0, x0) : max(0, x1)] = 0
-    return red, blue
+
+
+class NearerCleared:
+    """:func:`without_nearer` of a list of nearer candidates that only grows (the structure search's own, nearest
+    first): the masks are copied once and each candidate's box cleared once, not every call anew."""
+
+    __slots__ = ("_blue", "_done", "_red", "_scale")
+
+    def __init__(self, red: np.ndarray, blue: np.ndarray, scale: int) -> None:
+        self._red, self._blue, self._scale, self._done = red, blue, scale, 0
+
+    def masks(self, nearer: Sequence[Candidate]) -> Tuple[np.ndarray, np.ndarray]:
+        """``without_nearer(red, blue, nearer, scale)``; ``nearer`` must extend the list of the call before."""
+        if len(nearer) > self._done:
+            if not self._done:  # the caller's masks are copied once; later boxes are cleared in the copies
+                self._red, self._blue = self._red.copy(), self._blue.copy()
+            _clear(self._red, self._blue, nearer[self._done :], self._scale)
+            self._done = len(nearer)
+        return self._red, self._blue
 
 
 def occluded_sides(cands: List[Candidate], scale: int) -> List[Candidate]:

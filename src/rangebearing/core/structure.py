@@ -31,7 +31,7 @@ from typing import Callable, List, NamedTuple, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
-from .behind import occluded_sides, without_nearer
+from .behind import NearerCleared, occluded_sides
 from .color import RELAXED_WHITE_V
 from .columns import WHITE_S_MAX, WHITE_V_MIN, bridge, column_edges, runs, window_runs  # noqa: F401  (the column scan lives there)
 from .denoise import both_outside
@@ -209,6 +209,7 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
     white_h = geometry.height_m - 2 * geometry.band_height_m
     band_k, width_k = geometry.band_height_m / white_h, geometry.diameter_m / white_h
     out: List[Candidate] = []
+    cleared = NearerCleared(red, blue, scale)  # the masks without the nearer candidates found so far (out)
     taken: List[BBox] = []
     pairs = region_pairs(reds, blues, MAX_PAIRS_PER_LANDMARK * max_landmarks)
     wins = [
@@ -235,7 +236,7 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
         seen, hidden, ext_l, ext_r = 1.0, "", False, False
         if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):  # a body hidden, bands whole
             # its bands end where a nearer landmark found already hides them (core/behind.py)
-            r_m, b_m = without_nearer(red, blue, out, scale)
+            r_m, b_m = cleared.masks(out)
             c0f, c1f, seen, hidden, ext_l, ext_r = extend_along_bands(frag, r_m, b_m, band_k, width_k)
         s0, s1 = int(c0f), int(c1f)
         n = s1 - s0

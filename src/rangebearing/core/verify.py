@@ -65,7 +65,7 @@ from .model import normalised
 from .params import ModelParams
 from .stats import percentile
 from .stripes import SAMPLES, striped
-from .types import CameraIntrinsics, LandmarkGeometry
+from .types import BBox, CameraIntrinsics, LandmarkGeometry
 
 # twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
 ROBOT_APART_M, TWIN_PX = 0.08, 1.5
@@ -114,6 +114,13 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     return math.hypot(apart_m, depth_m * 2 * TWIN_PX / spacing) < ROBOT_APART_M and not limbs_between(bgr, c, o)
 
 
+def _right_beside(c: BandCentroids, others: Sequence[BandCentroids], boxes: Sequence[BBox]) -> List[BandCentroids]:
+    """The ``others`` (``boxes`` their ``bbox_px``) right beside ``c``: the only ones :func:`twins` can find twins."""
+    x, _, w, _ = c.bbox_px
+    return [o for o, (ox, _, ow, _) in zip(others, boxes)
+            if o is not c and (abs(ox - (x + w)) <= 2 * TWIN_PX or abs(x - (ox + ow)) <= 2 * TWIN_PX)]
+
+
 def limbs_between(bgr: np.ndarray, c: BandCentroids, o: BandCentroids) -> bool:
     """Whether the white body darkens where ``c`` and ``o`` meet: two cylinders' limbs, not one surface.
 
@@ -160,7 +167,8 @@ def height_off_m(c: BandCentroids, model: ModelParams, cam: CameraIntrinsics) ->
 
 
 def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, model: Optional[ModelParams] = None,
-              cam: Optional[CameraIntrinsics] = None, others: Sequence[BandCentroids] = ()) -> Optional[str]:
+              cam: Optional[CameraIntrinsics] = None, others: Sequence[BandCentroids] = (),
+              boxes: Optional[Sequence[BBox]] = None) -> Optional[str]:
     """Why ``c`` is no landmark, or ``None`` when it passes every check (see the module docstring).
 
     Parameters
@@ -176,6 +184,8 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
         (``model.centre_sigma_m > 0``) the candidate must stand at it.
     others : sequence of BandCentroids
         The frame's other candidates (touching neighbours are no stripes).
+    boxes : sequence of BBox, optional
+        ``o.bbox_px`` of each of ``others``, when the caller has them (:func:`verdicts`: once a frame).
     """
     cand = c.candidate
     if model is not None and cam is not None and model.centre_sigma_m > 0:
@@ -184,7 +194,8 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
             return f"its centre is {100 * off:+.1f} cm off the height where landmarks stand"
     elif cand is not None and cand.red_merged and cand.blue_merged:
         return "both bands merge with their backgrounds: no edge of the landmark's own"
-    if cam is not None and any(twins(bgr, c, o, geometry, cam) for o in others):
+    boxes = [o.bbox_px for o in others] if boxes is None else boxes
+    if cam is not None and any(twins(bgr, c, o, geometry, cam) for o in _right_beside(c, others, boxes)):
         return "a candidate of its size beside it, closer than two robots' landmarks can stand: one thing cut"
     ry, by = c.red_xy_px[1], c.blue_xy_px[1]
     spacing = by - ry
@@ -203,7 +214,7 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     white_b = _level(bgr, body, cols, 0, WHITE_PCT)
     if red_r > BAND_OVER_WHITE * white_r or blue_b > BAND_OVER_WHITE * white_b:
         return "the white body is darker than a band in the band's own channel"
-    if striped(bgr, c, ((ry - 0.25 * band, ry + 0.25 * band), body), others):
+    if striped(bgr, c, ((ry - 0.25 * band, ry + 0.25 * band), body), others, boxes):
         return "its red band and white body run on beside it: stripes, not an object"
     return None
 
@@ -217,12 +228,15 @@ def verdicts(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: Landmark
     candidates side by side (a skirting board cut by masts and robots), each excusing the next.
     The candidates passing are judged again against those still passing, once more at most.
     """
-    why = [rejection(bgr, c, geometry, model, cam, found) for c in found]
+    boxes = [c.bbox_px for c in found]  # a property: made once a frame, not once a pair
+    why = [rejection(bgr, c, geometry, model, cam, found, boxes) for c in found]
     for _ in range(2):
         kept = [c for c, w in zip(found, why) if w is None]
         if len(kept) in (0, len(found)):
             break
-        again = [rejection(bgr, c, geometry, model, cam, kept) if w is None else w for c, w in zip(found, why)]
+        kept_boxes = [b for b, w in zip(boxes, why) if w is None]
+        again = [rejection(bgr, c, geometry, model, cam, kept, kept_boxes) if w is None else w
+                 for c, w in zip(found, why)]
         if again == why:
             break
         why = again
