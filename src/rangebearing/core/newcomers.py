@@ -102,9 +102,9 @@ def side_view(
     if (last is not None and last.probe is not None and last.probe.shape == probe.shape and last.cuts == cuts
             and last.gains == gains and cv2.norm(probe, last.probe, cv2.NORM_INF) <= PROBE_CHANGE):
         return last
-    size = (half, h // 2)  # every other pixel of each strip: the full scan's resolution
-    strips = cv2.hconcat([cv2.resize(bgr[:, :s], size, interpolation=cv2.INTER_NEAREST),
-                          cv2.resize(bgr[:, w - s :], size, interpolation=cv2.INTER_NEAREST)])
+    # every other pixel of each strip (the full scan's resolution), as a nearest-neighbour halving picks them
+    rows = h // 2 * 2
+    strips = np.concatenate((bgr[:rows:2, :s:2], bgr[:rows:2, w - s :: 2]), axis=1)
     both = _both_colours(strips, cfg, gains, cuts)
     counts = (int(np.count_nonzero(both[:half])), int(np.count_nonzero(both[half:])))
     return SideView(counts, probe, cuts, gains)
@@ -144,27 +144,31 @@ def beside_count(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Seq
     and their own columns are not counted.
     """
     h, w = bgr.shape[:2]
-    strips, xs = [], []
+    strips: List[Tuple[int, int, int, int]] = []  # full-resolution rows y0:y1 and columns x0:x1, every other one
     for bx, by, bw, bh in boxes:
         y0, y1 = max(0, by - bh // 2), min(h, by + bh + bh // 2)
         left, right = bx - BESIDE_GAP_PX, bx + bw + BESIDE_GAP_PX
         for x0, x1 in ((left - bw, left), (right, right + bw)):
             x0, x1 = max(0, x0), min(w, x1)
             if x1 - x0 >= 2 and y1 - y0 >= 2:
-                strips.append(bgr[y0:y1:2, x0:x1:2])
-                xs.append(np.arange(x0, x1, 2))
+                strips.append((y0, y1, x0, x1))
     if not strips:
         return 0
-    rows = max(s.shape[0] for s in strips)
-    img = np.zeros((rows, sum(s.shape[1] for s in strips), 3), np.uint8)  # black pads: no band colour
-    at = 0
-    for s in strips:
-        img[: s.shape[0], at : at + s.shape[1]] = s
-        at += s.shape[1]
-    x = np.concatenate(xs)
-    b = np.asarray(boxes, np.int64).reshape(-1, 4)
-    followed = ((x[:, None] >= b[None, :, 0]) & (x[:, None] < b[None, :, 0] + b[None, :, 2])).any(axis=1)
-    return int(np.count_nonzero(_both_colours(img, cfg, gains) & ~followed))
+    rows = max(-(-(y1 - y0) // 2) for y0, y1, _, _ in strips)
+    img = np.zeros((rows, sum(-(-(x1 - x0) // 2) for _, _, x0, x1 in strips), 3), np.uint8)  # black pads
+    at, followed = 0, []
+    for y0, y1, x0, x1 in strips:
+        n = -(-(x1 - x0) // 2)
+        img[: -(-(y1 - y0) // 2), at : at + n] = bgr[y0:y1:2, x0:x1:2]
+        for bx, _, bw, _ in boxes:  # a followed landmark's columns (x0 + 2k inside its box)
+            k0, k1 = max(0, -(-(bx - x0) // 2)), min(n, -(-(bx + bw - x0) // 2))
+            if k1 > k0:
+                followed.append((at + k0, at + k1))
+        at += n
+    both = _both_colours(img, cfg, gains)
+    for k0, k1 in followed:
+        both[k0:k1] = False
+    return int(np.count_nonzero(both))
 
 
 def _both_colours(strips: np.ndarray, cfg: DetectionParams, gains: Gains, cuts: Sequence[Cut] = ()) -> np.ndarray:
