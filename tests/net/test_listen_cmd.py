@@ -144,3 +144,43 @@ def test_bad_swarm_arguments_are_rejected_by_the_parser(argv: List[str]) -> None
     with pytest.raises(SystemExit) as info:
         parser.parse_args(["swarm", *argv])
     assert info.value.code == 2
+
+
+def test_sigterm_ends_listening_cleanly_with_a_summary(tx: socket.socket) -> None:
+    """`kill` / `timeout 5 rangebearing listen` is how scripts end it: exit 0, no traceback, a summary."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    port = _free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rangebearing", "listen", "--port", str(port)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        assert proc.stdout is not None
+        line = ""
+        deadline = time.monotonic() + 30.0
+        seq = 0
+        while not line and time.monotonic() < deadline:  # resend until the listener is up and prints
+            tx.sendto(encode_reading("zumo", seq, 5.0, [make_landmark()]), ("127.0.0.1", port))
+            seq += 1
+            ready = __import__("select").select([proc.stdout], [], [], 0.2)[0]
+            if ready:
+                line = proc.stdout.readline()
+        assert line.startswith("zumo #"), line
+        tx.sendto(b"not a reading", ("127.0.0.1", port))
+        time.sleep(0.3)
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0, err
+    assert "Traceback" not in err
+    shown = 1 + out.count("zumo #")
+    assert f"rangebearing listen: terminated after {shown} readings on 127.0.0.1:{port}" in err
+    assert "(1 invalid datagrams dropped)" in err

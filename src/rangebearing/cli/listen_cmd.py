@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import io
 import json
+import signal
 import sys
+import threading
 from typing import Any, Optional, TextIO
 
 from ..config import DEFAULT_PORT
@@ -20,7 +22,8 @@ Listen for rangebearing readings and print one line per frame:
 
 Bearings are positive to the left of the camera's optical axis. Every daemon
 sends a reading for every frame, so silence means no daemon is publishing here.
-Exits 0 on Ctrl-C or after --count readings, 1 if --timeout passes in silence.
+Exits 0 on Ctrl-C, on SIGTERM (with a one-line summary on stderr) or after
+--count readings, 1 if --timeout passes in silence.
 
 With --zenoh, subscribe over Eclipse Zenoh instead of UDP (the same readings;
 needs the zenoh extra): by default as a peer listening on tcp/127.0.0.1:7447
@@ -86,6 +89,21 @@ def _one_line_json(data: bytes) -> str:
     return text
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, ``systemctl stop``, ``timeout``): ends listening as Ctrl-C does."""
+
+
+class _Shown:
+    """How many readings have been printed (read by the SIGTERM summary)."""
+
+    def __init__(self) -> None:
+        self.count = 0
+
+
+def _on_sigterm(signum: int, frame: Any) -> None:
+    raise _Terminated()
+
+
 def echo(
     sub: Any,
     out: TextIO,
@@ -93,6 +111,7 @@ def echo(
     count: Optional[int] = None,
     timeout_s: Optional[float] = None,
     where: Optional[str] = None,
+    shown_so_far: Optional[_Shown] = None,
 ) -> int:
     """Print readings from ``sub`` to ``out``; 0 after ``count`` readings.
 
@@ -101,6 +120,7 @@ def echo(
     NoReadingError
         Nothing valid arrived within ``timeout_s``.
     """
+    tally = shown_so_far if shown_so_far is not None else _Shown()
     shown = 0
     while count is None or shown < count:
         got = sub.recv_datagram(timeout_s)
@@ -114,6 +134,7 @@ def echo(
         line = _one_line_json(data) if as_json else format_reading(reading)
         print(line, file=out, flush=True)
         shown += 1
+        tally.count = shown
     return 0
 
 
@@ -137,8 +158,24 @@ def run(args: argparse.Namespace) -> int:
             raise SubscribeError(f"cannot listen on {where}: {exc.strerror or exc}") from None
     if isinstance(sys.stdout, io.TextIOWrapper):  # a terminal that cannot show a character gets an escape
         sys.stdout.reconfigure(errors="backslashreplace")
+    tally = _Shown()
+    previous = None
+    if threading.current_thread() is threading.main_thread():  # signal handlers live in the main thread only
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         with sub:
-            return echo(sub, sys.stdout, args.json, args.count, args.timeout, where)
+            return echo(sub, sys.stdout, args.json, args.count, args.timeout, where, tally)
+    except _Terminated:  # `kill`, `timeout 10 rangebearing listen`: the readings so far were the point
+        dropped = getattr(sub, "dropped", 0)
+        print(
+            f"rangebearing listen: terminated after {tally.count} readings on {where}"
+            + (f" ({dropped} invalid datagrams dropped)" if dropped else ""),
+            file=sys.stderr,
+            flush=True,
+        )
+        return 0
     except KeyboardInterrupt:  # Ctrl-C is how a user ends listening: not a failure
         return 0
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
