@@ -352,7 +352,8 @@ def test_record_refuses_a_limit_that_records_nothing(limit: List[str], tmp_path:
 
 WHY = {  # each skipped frame's line says why it is unreadable
     "non-image files": {"003.png": "not an image (no PNG, JPEG or BMP header)"},
-    "truncated png and jpeg": {"003.png": "corrupt or truncated", "004.jpg": "corrupt or truncated",
+    "truncated png and jpeg": {"003.png": "truncated: the PNG is cut short in its IDAT chunk",
+                               "004.jpg": "truncated: the JPEG is cut short in its headers",
                                "005.png": "an empty file (0 bytes)"},
     "huge images": {"003.png": "its header says 40000×40000 = 1600000000 px, over the 67108864 px",
                     "004.png": "its header says 9000×9000 = 81000000 px, over the 67108864 px"},

@@ -7,7 +7,7 @@ import dataclasses
 import math
 import sys
 from pathlib import Path
-from typing import Any, List, Tuple
+from typing import Any, Dict, List, Tuple
 
 import cv2
 import numpy as np
@@ -80,10 +80,12 @@ def run(args: argparse.Namespace) -> int:
     size = None
     seen = missed = 0
     try:
-        for name, image in progress(iter_recorded(path), count_recorded(path), "intrinsics", quiet_or_auto(args)):
+        reasons: Dict[str, str] = {}
+        for name, image in progress(iter_recorded(path, reasons), count_recorded(path), "intrinsics",
+                                    quiet_or_auto(args)):
             seen += 1
             if image is None:
-                print(f"{name}: unreadable, skipped", file=sys.stderr)
+                print(f"{name}: unreadable, skipped: {reasons.pop(name, 'no image')}", file=sys.stderr)
                 continue
             h, w = image.shape[:2]
             if size is None:

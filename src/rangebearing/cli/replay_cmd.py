@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any, List, Tuple, Union
+from typing import Any, Dict, List, Tuple, Union
 
 import cv2
 
@@ -18,7 +18,6 @@ from ..evaluation.annotate import annotate
 from ..evaluation.identity import format_id_report, id_report
 from ..evaluation.match import accuracy, format_report
 from ..net.protocol import landmark_fields
-from ..sources.image_bytes import why_undecodable
 from ..sources.recorded import count_recorded, iter_recorded
 from .common import add_config_arg, aligned_truth, config_from_args, describe, progress
 from .outputs import AtomicText, check_output_dir, check_output_file, write_bytes_atomic
@@ -64,12 +63,13 @@ def run(args: argparse.Namespace) -> int:
     # the bar shares the terminal with the per-frame lines only when those go elsewhere (-q, or piped)
     bar = None if (args.quiet or not sys.stdout.isatty()) else False
     try:
-        for name, image in progress(iter_recorded(path), count_recorded(path), "replay", bar):
+        reasons: Dict[str, str] = {}
+        for name, image in progress(iter_recorded(path, reasons), count_recorded(path), "replay", bar):
             done += 1
             try:
                 if image is None:
-                    why = f": {why_undecodable(path / name)}" if path.is_dir() else ""
-                    raise FrameError(f"unreadable image{why}")
+                    why = reasons.pop(name, "")
+                    raise FrameError(f"unreadable image: {why}" if why else "unreadable image")
                 result = process_or_skip(pipe, image)
             except FrameError as exc:  # a bad frame, or a detector defect on it (DetectorFault): skipped, counted
                 bad += 1

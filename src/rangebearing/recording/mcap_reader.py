@@ -66,6 +66,7 @@ class RecordedFrame:
     index: int
     t_ns: int
     image: Optional[np.ndarray]
+    why: str = ""  # with ``image`` None (decoded): why the message gives no image
 
 
 def _stream_reader(f: Any) -> Any:
@@ -83,6 +84,15 @@ def decode_image(img: ImageMessage) -> Optional[np.ndarray]:
     from ..sources.image_bytes import decode
 
     return decode(img.data)
+
+
+def why_image_undecodable(img: Union[ImageMessage, str]) -> str:
+    """Why an image message gives no image: the message is not one (``img`` is then that reason), or its bytes."""
+    from ..sources.image_bytes import why_bytes_undecodable
+
+    if isinstance(img, str):
+        return img
+    return f"its {img.fmt or 'unnamed'} data: {why_bytes_undecodable(img.data)}"
 
 
 def _damaged(path: str, offset: int, exc: BaseException) -> None:
@@ -137,21 +147,23 @@ class McapRecording:
                     if topic is not None and (wanted is None or topic in wanted):
                         yield RecordedMessage(topic, record.log_time, record.sequence, bytes(record.data))
 
-    def images(self) -> Iterator[Tuple[int, int, Optional[ImageMessage]]]:
-        """``(position, source index, image message)`` per frame, not decoded (``None``: not an image)."""
+    def images(self) -> Iterator[Tuple[int, int, Union[ImageMessage, str]]]:
+        """``(position, source index, image message)`` per frame, not decoded (a ``str``: why it is not an image)."""
         for pos, msg in enumerate(self.messages([IMAGE_TOPIC])):
             try:
                 yield pos, msg.sequence, parse_image(msg.data)
-            except RecordingError:
-                yield pos, msg.sequence, None
+            except RecordingError as exc:
+                yield pos, msg.sequence, f"the message on {IMAGE_TOPIC} is {exc}"
 
     def frames(self, decode: bool = True) -> Iterator[RecordedFrame]:
         """The frames in file order; ``decode=False`` leaves ``image`` None (timestamps only)."""
         for pos, index, img in self.images():
-            if img is None:
-                yield RecordedFrame(pos, index, 0, None)
+            if isinstance(img, str):
+                yield RecordedFrame(pos, index, 0, None, img)
                 continue
-            yield RecordedFrame(pos, index, img.t_ns, decode_image(img) if decode else None)
+            image = decode_image(img) if decode else None
+            why = why_image_undecodable(img) if decode and image is None else ""
+            yield RecordedFrame(pos, index, img.t_ns, image, why)
 
     def frame_times_ns(self) -> List[int]:
         """The capture time of every frame, by position in the file."""

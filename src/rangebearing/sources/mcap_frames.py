@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import struct
-from typing import Any, Iterator, List, Optional, Tuple, Union
+from typing import Any, Dict, Iterator, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -39,10 +39,12 @@ def is_mcap_file(path: PathLike) -> bool:
         return False
 
 
-def iter_mcap(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
-    """Yield ``(str(position), image)`` per frame; an undecodable one as ``(name, None)``."""
+def iter_mcap(path: PathLike, reasons: Optional[Dict[str, str]] = None) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
+    """Yield ``(str(position), image)`` per frame; an undecodable one as ``(name, None)``, its reason in ``reasons``."""
     try:
         for frame in _recording(path).frames():
+            if frame.image is None and reasons is not None:
+                reasons[str(frame.position)] = frame.why
             yield str(frame.position), frame.image
     except MissingExtraError as exc:
         raise SourceError(str(exc)) from None
@@ -83,9 +85,16 @@ class McapFrames:
         self._frames: Optional[Iterator[Any]] = None
         self._pos = 0  # position of the frame the iterator yields next
         self.length: Optional[int] = None  # learned when the end is reached
+        self._why: Tuple[int, Any] = (-1, "")  # the last undecodable frame: position, its message (or reason)
 
     def name(self, pos: int) -> str:
         return str(pos)
+
+    def why(self, pos: int) -> str:
+        """Why the frame at ``pos`` (the last one :meth:`get` gave as ``None``) gives no image."""
+        from ..recording.mcap_reader import why_image_undecodable
+
+        return why_image_undecodable(self._why[1]) if self._why[0] == pos else "the recording's image does not decode"
 
     def get(self, pos: int) -> Any:
         from ..recording.mcap_reader import decode_image
@@ -96,7 +105,10 @@ class McapFrames:
         for position, _index, img in self._frames:
             self._pos += 1
             if position == pos:
-                return None if img is None else decode_image(img)
+                image = None if isinstance(img, str) else decode_image(img)
+                if image is None:
+                    self._why = (pos, img)
+                return image
         self.length = self._pos
         return self._end
 

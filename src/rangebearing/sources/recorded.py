@@ -52,12 +52,15 @@ def _check_path(path: PathLike) -> Path:
     return p
 
 
-def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
+def iter_recorded(
+    path: PathLike, reasons: Optional[Dict[str, str]] = None
+) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     """Yield ``(name, image)`` for every recorded frame, decoding one at a time.
 
     A directory yields its images sorted by file name, an unreadable image as
     ``(name, None)``; a video or an MCAP recording yields ``(str(i), image)``
-    for frame ``i``.
+    for frame ``i``. ``reasons`` (when given) gets ``name: why`` for every
+    frame yielded as ``None``, before it is yielded.
 
     Raises
     ------
@@ -68,10 +71,13 @@ def iter_recorded(path: PathLike) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
     p = _check_path(path)
     if p.is_dir():
         for img_path in list_images(p):
-            yield img_path.name, _decode(img_path)
+            image = _decode(img_path)
+            if image is None and reasons is not None:
+                reasons[img_path.name] = why_undecodable(img_path)
+            yield img_path.name, image
         return
     if is_mcap_file(p):
-        yield from iter_mcap(p)
+        yield from iter_mcap(p, reasons)
         return
     cap = open_video(p)
     try:
@@ -123,6 +129,10 @@ class _ImageDir:
 
     def name(self, pos: int) -> str:
         return self.paths[pos].name
+
+    def why(self, pos: int) -> str:
+        """Why the image at ``pos`` gives no frame."""
+        return why_undecodable(self.paths[pos])
 
     def get(self, pos: int) -> Fetched:
         if self._cache is None:
@@ -254,7 +264,7 @@ class RecordedSource:
             return None
         self._next = i + 1
         if fetched[1] is None:
-            why = why_undecodable(reader.paths[fetched[0]]) if isinstance(reader, _ImageDir) else "cannot decode"
+            why = reader.why(fetched[0])
             raise FrameError(f"{reader.name(fetched[0])}: unreadable image: {why}")
         return self._frame(reader, fetched, i)
 

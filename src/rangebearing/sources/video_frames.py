@@ -40,6 +40,10 @@ class VideoFrames:
     def name(self, pos: int) -> str:
         return str(pos)
 
+    def why(self, pos: int) -> str:
+        """Why frame ``pos`` gives no image (a video's decoder never gives one short of its end)."""
+        return "the video's decoder gives no image"
+
     def get(self, pos: int) -> Fetched:
         if self._cap is None or pos < self._pos:
             self.close()
