@@ -270,13 +270,13 @@ class TestRecordedSource:
     ) -> None:
         write_images(tmp_path, 5)
         decoded: List[str] = []
-        real = recorded_mod._decode
+        real = recorded_mod.decode_file
 
         def counting(path: Path) -> Optional[np.ndarray]:
             decoded.append(path.name)
             return real(path)
 
-        monkeypatch.setattr(recorded_mod, "_decode", counting)
+        monkeypatch.setattr(recorded_mod, "decode_file", counting)
         source = RecordedSource(tmp_path)
         source.open()
         assert decoded == []

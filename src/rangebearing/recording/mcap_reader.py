@@ -88,7 +88,7 @@ def decode_image(img: ImageMessage) -> Optional[np.ndarray]:
 
 def why_image_undecodable(img: Union[ImageMessage, str]) -> str:
     """Why an image message gives no image: the message is not one (``img`` is then that reason), or its bytes."""
-    from ..sources.image_bytes import why_bytes_undecodable
+    from ..sources.image_damage import why_bytes_undecodable
 
     if isinstance(img, str):
         return img

@@ -4,107 +4,23 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Callable, Dict, Iterator, List, Optional, Tuple, Union
+from typing import Callable, Dict, Optional, Tuple, Union
 
-import cv2
 import numpy as np
 
 from ..core.yuv import Yuv420
 from ..errors import FrameError, SourceError
 from .base import Frame, with_lores
 from .clip_store import ClipStore
-from .image_bytes import decode_file, why_undecodable
-from .mcap_frames import McapFrames, count_mcap, is_mcap_file, iter_mcap
+from .image_bytes import decode_file
+from .image_damage import why_undecodable
+from .mcap_frames import McapFrames, is_mcap_file
 from .pacing import Pacer
-from .video_frames import END, EndOfVideo, VideoFrames, open_video
+from .recorded_files import IMAGE_SUFFIXES, check_recording_path, count_recorded, iter_recorded, list_images
+from .video_frames import END, EndOfVideo, VideoFrames
 
-IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 PathLike = Union[str, Path]
 _CACHE_BYTES = 64 * 1024 * 1024  # decoded frames kept in memory for looping when no ClipStore can take them
-
-
-def list_images(directory: Path) -> List[Path]:
-    """Image files in ``directory`` sorted by name (a broken link too: a bad frame, counted); others ignored."""
-    return sorted(
-        (p for p in directory.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES
-         and (p.is_file() or (p.is_symlink() and not p.exists()))),
-        key=lambda p: p.name,
-    )
-
-
-def _decode(path: Path) -> Optional[np.ndarray]:
-    return decode_file(path)  # any file name; None, not an exception, for a corrupt, huge or unreadable file
-
-
-def _check_path(path: PathLike) -> Path:
-    p = Path(path)
-    if not str(path):
-        raise SourceError("no recording path given (source.path is empty)")
-    if not p.exists():
-        raise SourceError(f"{p}: no such file or directory")
-    if p.is_fifo() or p.is_socket():  # opening one would wait for a writer for ever
-        raise SourceError(f"{p}: a {'FIFO' if p.is_fifo() else 'socket'}, not a recording (a folder of images, "
-                          "a video or an MCAP file)")
-    if p.is_dir() and not list_images(p):
-        raise SourceError(f"{p}: holds no images ({', '.join(IMAGE_SUFFIXES)})")
-    if p.suffix.lower() == ".mcap" and p.is_file() and not is_mcap_file(p):
-        raise SourceError(f"{p}: not an MCAP file (no MCAP magic at its start: empty, or another format)")
-    return p
-
-
-def iter_recorded(
-    path: PathLike, reasons: Optional[Dict[str, str]] = None
-) -> Iterator[Tuple[str, Optional[np.ndarray]]]:
-    """Yield ``(name, image)`` for every recorded frame, decoding one at a time.
-
-    A directory yields its images sorted by file name, an unreadable image as
-    ``(name, None)``; a video or an MCAP recording yields ``(str(i), image)``
-    for frame ``i``. ``reasons`` (when given) gets ``name: why`` for every
-    frame yielded as ``None``, before it is yielded.
-
-    Raises
-    ------
-    SourceError
-        The path does not exist, the directory holds no images, or OpenCV
-        cannot open the video.
-    """
-    p = _check_path(path)
-    if p.is_dir():
-        for img_path in list_images(p):
-            image = _decode(img_path)
-            if image is None and reasons is not None:
-                reasons[img_path.name] = why_undecodable(img_path)
-            yield img_path.name, image
-        return
-    if is_mcap_file(p):
-        yield from iter_mcap(p, reasons)
-        return
-    cap = open_video(p)
-    try:
-        i = 0
-        while True:
-            ok, image = cap.read()
-            if not ok:
-                return
-            yield str(i), image
-            i += 1
-    finally:
-        cap.release()
-
-
-def count_recorded(path: PathLike) -> Optional[int]:
-    """How many frames :func:`iter_recorded` will yield, or None if the video does not say."""
-    p = _check_path(path)
-    if p.is_dir():
-        return len(list_images(p))
-    if is_mcap_file(p):
-        return count_mcap(p)
-    cap = open_video(p)
-    try:
-        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
-    finally:
-        cap.release()
-    return n if n > 0 else None
 
 
 Fetched = Union[Optional[np.ndarray], EndOfVideo]
@@ -136,14 +52,14 @@ class _ImageDir:
 
     def get(self, pos: int) -> Fetched:
         if self._cache is None:
-            return _decode(self.paths[pos])
+            return decode_file(self.paths[pos])
         stored = self._store.get(("bgr", pos)) if self._store is not None else None
         if stored is not None:
             image: Optional[np.ndarray] = stored[0]
         elif pos in self._cache:
             image = self._cache[pos]
         else:
-            image = _decode(self.paths[pos])
+            image = decode_file(self.paths[pos])
             kept = self._store.put(("bgr", pos), [image]) if self._store is not None and image is not None else None
             if kept is not None:
                 image = kept[0]
@@ -216,7 +132,7 @@ class RecordedSource:
         """Check the recording and start the virtual camera clock."""
         if self._reader is not None:
             return
-        p = _check_path(self._path)
+        p = check_recording_path(self._path)
         files = McapFrames(p, END) if not p.is_dir() and is_mcap_file(p) else None
         self._reader = (_ImageDir(p, self._loop, self._in_place, self._store) if p.is_dir()
                         else files or VideoFrames(p))
@@ -308,3 +224,6 @@ class RecordedSource:
             if not self._loop:
                 return None
         return None
+
+
+__all__ = ["IMAGE_SUFFIXES", "RecordedSource", "count_recorded", "iter_recorded", "list_images"]

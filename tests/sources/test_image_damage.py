@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from rangebearing.sources import image_bytes
-from rangebearing.sources.image_bytes import decode, decode_file, why_bytes_undecodable, why_undecodable
+from rangebearing.sources.image_bytes import decode, decode_file
+from rangebearing.sources.image_damage import why_bytes_undecodable, why_undecodable
 
 
 def _frame() -> np.ndarray:
