@@ -163,3 +163,79 @@ def test_what_libcamera_grants_instead_is_what_the_configuration_says(fake_picam
     assert granted["main"]["format"] == "XBGR8888" and granted["lores"]["format"] == "YVU420"
     assert granted["colour_space"] == libcamera.ColorSpace.Rec709()
     cam.close()
+
+
+def test_a_false_wait_gives_a_job_with_get_result(fake_picamera2: ModuleType) -> None:
+    cam = started(fake_picamera2)
+    job = cam.capture_request(wait=0)  # dispatch_functions: `if wait` is false, so the Job itself
+    request = job.get_result(timeout=0.5)  # job.py's Job.get_result, as Picamera2.wait(job) calls it
+    assert request.make_array("main").shape == (6, 8, 3)
+    request.release()
+    assert cam.wait(cam.capture_request(wait=False), timeout=0.5).release() is None
+    assert fake_picamera2.WORLD.outstanding == []
+    cam.close()
+
+
+def test_capture_array_and_metadata_release_their_request(fake_picamera2: ModuleType) -> None:
+    fake_picamera2.WORLD.producer = red
+    cam = started(fake_picamera2)
+    array = cam.capture_array("main", wait=0.5)  # capture_array_: make_array, then release
+    assert array.shape == (6, 8, 3) and array.flags.c_contiguous and array[0, 0].tolist() == [0, 0, 200]
+    assert isinstance(cam.capture_metadata(wait=0.5)["SensorTimestamp"], int)
+    assert fake_picamera2.WORLD.outstanding == []  # nothing held: the camera keeps running
+    assert all(cam.capture_array(wait=0.5) is not None for _ in range(5))  # more than buffer_count frames
+    cam.close()
+
+
+def test_configure_checks_streams_as_picamera2_does(fake_picamera2: ModuleType) -> None:
+    cam = fake_picamera2.Picamera2(0)
+    config = cam.create_video_configuration(main={"format": "RGB888", "size": (8, 6)})
+    for main, message in (({"format": "RGB888", "size": [8, 6]}, "should be \\(width, height\\)"),
+                          ({"format": "RGB888", "size": (7, 6)}, "should be even"),
+                          ({"size": (8, 6)}, "format not found")):
+        with pytest.raises(RuntimeError, match=message):
+            cam.configure({**config, "main": main})
+    with pytest.raises(RuntimeError, match="'raw' key expected"):
+        cam.configure({k: v for k, v in config.items() if k != "raw"})
+    cam.close()
+
+
+def test_configure_fills_in_the_callers_stream_dicts(fake_picamera2: ModuleType) -> None:
+    cam = fake_picamera2.Picamera2(0)
+    config = cam.create_video_configuration(main={"format": "RGB888", "size": (100, 10)},
+                                            lores={"format": "YUV420", "size": (100, 10)})
+    cam.configure(config)  # picamera2 copies the outer dict only; _update_stream_config writes into the streams
+    assert config["main"]["stride"] == cam.stream_configuration("main")["stride"] == 320
+    lores = cam.stream_configuration("lores")
+    assert lores["stride"] == 128 > lores["size"][0] and config["lores"] is lores
+    with pytest.raises(KeyError):
+        cam.stream_configuration("nope")
+    cam.close()
+
+
+def test_padded_lores_keeps_u_and_v_at_half_the_stride(fake_picamera2: ModuleType) -> None:
+    fake_picamera2.WORLD.producer = red
+    cam = fake_picamera2.Picamera2(0)
+    cam.configure(cam.create_video_configuration(main={"format": "RGB888", "size": (100, 10)},
+                                                 lores={"format": "YUV420", "size": (100, 10)}))
+    cam.start()
+    request = cam.capture_request(wait=0.5)
+    with fake_picamera2.MappedArray(request, "lores") as m:
+        buf = m.array
+        assert buf.shape == (15, 128)
+        chroma = buf[10:].reshape(2, 5, 64)  # U then V: 5 rows each of stride/2 bytes
+        u, v = chroma[0, :, :50], chroma[1, :, :50]
+        assert int(v.mean()) > 200 > 100 > int(u.mean())  # red: Cr high, Cb low
+        assert (chroma[:, :, 50:] == 77).all()  # the padding is junk, not pixels
+    request.release()
+    cam.close()
+
+
+def test_align_configuration_rounds_to_the_isp(fake_picamera2: ModuleType) -> None:
+    cam = fake_picamera2.Picamera2(0)
+    config = cam.create_video_configuration(main={"format": "RGB888", "size": (101, 11)},
+                                            lores={"format": "YUV420", "size": (100, 10)})
+    assert config["main"]["size"] == (100, 10)  # align_stream(optimal=False): even
+    cam.align_configuration(config)
+    assert config["main"]["size"] == (96, 10) and config["lores"]["size"] == (64, 10)
+    cam.close()

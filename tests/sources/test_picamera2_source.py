@@ -354,3 +354,21 @@ def test_a_sleep_that_returns_true_stops_the_retries(world: Any) -> None:
     with pytest.raises(CameraError, match="no camera 0"):
         Picamera2Source(make_cfg(retries=5), sleep=interrupted).open()
     assert calls == [0.5]
+
+
+def test_a_picamera2_without_capture_request_reads_capture_array(world: Any, fake_picamera2: ModuleType,
+                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    class Arrays(fake_picamera2.Picamera2):  # type: ignore[name-defined,misc]
+        capture_request = None  # only capture_array(name, wait=): copies, the request released inside
+
+    monkeypatch.setattr(fake_picamera2, "Picamera2", Arrays)
+    world.producer = red
+    source = Picamera2Source(make_cfg(), sleep=Sleeps(), in_place=True)
+    source.open()
+    try:
+        frames = [source.read() for _ in range(8)]  # more than buffer_count: nothing may be held
+        assert all(f.image.shape == (H, W, 3) and f.image[0, 0].tolist() == [0, 0, 255] for f in frames)
+        assert all(f.lores_yuv420 is None for f in frames)  # main only: searched in full
+        assert world.outstanding == [] and set(world.capture_waits) == {0.02}
+    finally:
+        source.close()

@@ -11,7 +11,15 @@ Mirrors raspberrypi/picamera2 (picamera2.py, request.py, job.py):
   next frame (and leaks its request) unless ``cancel_all_and_flush()`` is
   called. ``stop()`` queues behind such a job and hangs. As
   ``dispatch_functions`` does, a false ``wait`` (``False``, but also ``0``)
-  and ``wait=None`` with a ``signal_function`` return the Job, not a request.
+  and ``wait=None`` with a ``signal_function`` return the Job, not a request;
+  ``job.get_result(timeout)`` (or ``cam.wait(job, timeout)``) gives its result.
+  ``capture_array(name)`` and ``capture_metadata()`` are jobs too: the request
+  is released inside (``capture_array_``), the array a contiguous copy.
+* ``configure()`` checks the config as ``check_camera_config`` does (the five
+  keys; each stream a dict with a str format and an even (w, h) TUPLE, else
+  RuntimeError) and, copying only the outer dict, writes ``stride`` and
+  ``framesize`` into the caller's own stream dicts; ``stream_configuration(name)``
+  is ``camera_config[name]``; ``align_configuration`` rounds as on VC4.
 * ``"RGB888"`` arrays are [B, G, R] per pixel, ``"BGR888"`` [R, G, B],
   ``"XBGR8888"`` [R, G, B, 255], ``"XRGB8888"`` [B, G, R, 255].
 * Requests are reference counted and hold one of ``buffer_count`` buffers;
@@ -210,9 +218,17 @@ class MappedArray:
 
 
 class _Job:
-    def __init__(self) -> None:
+    """job.py's Job: a Future completed by the frame that runs it; ``finish`` turns the request into the result."""
+
+    def __init__(self, finish: Optional[Callable[[CompletedRequest], Any]] = None) -> None:
         self.future: Future = Future()
         self.future.set_running_or_notify_cancel()
+        self._future = self.future  # the real attribute's name
+        self.finish = finish  # None: the request itself (capture_request), the caller must release it
+
+    def get_result(self, timeout: Optional[float] = None) -> Any:
+        """Blocks (None: forever) for the result; concurrent.futures.TimeoutError past ``timeout``."""
+        return self.future.result(timeout=timeout)
 
     def cancel(self) -> None:
         if not self.future.done():
@@ -223,7 +239,7 @@ class Picamera2:
     """The fake camera: see the module docstring for the behaviour it copies."""
 
     def __init__(
-        self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None
+        self, camera_num: int = 0, verbose_console: Any = None, tuning: Any = None, allocator: Any = None
     ) -> None:
         with WORLD.lock:
             if not 0 <= camera_num < WORLD.num_cameras:
@@ -287,11 +303,15 @@ class Picamera2:
     def configure(self, camera_config: Dict[str, Any]) -> None:
         if self.started:
             raise RuntimeError("Camera must be stopped before configuring")
-        config = dict(camera_config)
+        if not isinstance(camera_config, dict):
+            raise TypeError("Invalid type for `camera_config` given")
+        config = dict(camera_config)  # a shallow copy: the stream dicts are the caller's, updated in place
+        _check_camera_config(config)
         adjusted = dict(WORLD.adjusted)  # libcamera's validate(): what the camera can give instead
         if "colour_space" in adjusted:
             config["colour_space"] = adjusted.pop("colour_space")
-        main = {**config["main"], **adjusted.get("main", {})}
+        main = config["main"]
+        main.update(adjusted.get("main", {}))
         if main["format"] not in _BYTES_PER_PIXEL:
             raise RuntimeError(f"Bad format {main['format']} in stream main")
         if not isinstance(config["transform"], libcamera.Transform):
@@ -308,7 +328,8 @@ class Picamera2:
         main["framesize"] = main["stride"] * main["size"][1]
         config["main"] = main
         if config.get("lores") is not None:
-            lores = {**config["lores"], **adjusted.get("lores", {})}
+            lores = config["lores"]
+            lores.update(adjusted.get("lores", {}))
             if lores["format"] not in ("YUV420", "YVU420"):
                 raise RuntimeError("lores stream must be YUV")
             if lores["size"][0] > main["size"][0] or lores["size"][1] > main["size"][1]:
@@ -332,6 +353,32 @@ class Picamera2:
     def camera_configuration(self) -> Optional[Dict[str, Any]]:
         return self.camera_config
 
+    def stream_configuration(self, name: str = "main") -> Dict[str, Any]:
+        """``camera_config[name]``: granted format, size, ``stride`` and ``framesize`` (KeyError for no such name)."""
+        return self.camera_config[name]
+
+    @staticmethod
+    def align_stream(stream_config: Dict[str, Any], optimal: bool = True) -> None:
+        """Round the width down to the ISP's alignment (VC4: 32 px; YUV420 64, 4-byte RGB 16), the height to even."""
+        align = 2
+        if optimal:
+            align = 32
+            if stream_config["format"] in ("YUV420", "YVU420"):
+                align *= 2
+            elif stream_config["format"] in ("XBGR8888", "XRGB8888"):
+                align //= 2
+        w, h = stream_config["size"]
+        stream_config["size"] = (w - w % align, h - h % 2)
+
+    @staticmethod
+    def align_configuration(config: Dict[str, Any], optimal: bool = True) -> None:
+        Picamera2.align_stream(config["main"], optimal=optimal)
+        if config.get("lores") is not None:
+            Picamera2.align_stream(config["lores"], optimal=optimal)
+
+    def wait(self, job: _Job, timeout: Optional[float] = None) -> Any:
+        return job.get_result(timeout=timeout)
+
     def start(self, config: Any = None, show_preview: Any = False) -> None:
         if config is not None:
             self.configure(config)
@@ -344,7 +391,19 @@ class Picamera2:
     def capture_request(
         self, wait: Any = None, signal_function: Any = None, flush: Any = None
     ) -> Any:
-        job = _Job()
+        return self._dispatch(None, wait, signal_function)
+
+    def capture_array(self, name: str = "main", wait: Any = None, signal_function: Any = None) -> Any:
+        """A copy of the next frame's ``name`` stream (``make_array``); the request is released inside."""
+        return self._dispatch(lambda request: request.make_array(name), wait, signal_function)
+
+    def capture_metadata(self, wait: Any = None, signal_function: Any = None) -> Any:
+        """The next frame's metadata; the request is released inside."""
+        return self._dispatch(lambda request: request.get_metadata(), wait, signal_function)
+
+    def _dispatch(self, finish: Any, wait: Any, signal_function: Any) -> Any:
+        """``dispatch_functions``: wait=None waits unless there is a signal function; a false wait gives the Job."""
+        job = _Job(finish)
         with WORLD.lock:
             WORLD.capture_waits.append(wait)
             self._jobs.append(job)
@@ -389,8 +448,18 @@ class Picamera2:
         while self._jobs and self.started and not WORLD.stalled and self._buffers_free():
             job = self._jobs.pop(0)
             request = self._next_request()
-            WORLD.outstanding.append(request)
-            job.future.set_result(request)
+            if job.finish is None:  # capture_request: the caller holds the request until it releases it
+                WORLD.outstanding.append(request)
+                job.future.set_result(request)
+                continue
+            try:
+                result = job.finish(request)
+            except Exception as exc:  # Job.execute: the exception is the job's result
+                job.future.set_exception(exc)
+            else:
+                job.future.set_result(result)
+            request.ref_count = 0  # capture_array_ / capture_metadata_ release it at once
+            request._buffers = None
 
     def _exposure(self, w: int, h: int) -> Dict[str, Any]:
         """Apply due controls; the metadata of the frame about to be made."""
@@ -466,6 +535,30 @@ class Picamera2:
         u, v = flat[w * h: w * h + n].reshape(h // 2, w // 2), flat[w * h + n:].reshape(h // 2, w // 2)
         chroma[0, :, : w // 2], chroma[1, :, : w // 2] = (u, v) if lores["format"] == "YUV420" else (v, u)
         return buf
+
+
+def _check_camera_config(config: Dict[str, Any]) -> None:
+    """picamera2's check_camera_config / check_stream_config: the RuntimeErrors a malformed config gets."""
+    for name in ("colour_space", "transform", "main", "lores", "raw"):
+        if name not in config:
+            raise RuntimeError(f"{name!r} key expected in camera configuration")
+    for name in ("main", "lores"):
+        stream = config[name]
+        if stream is None and name == "lores":
+            continue
+        if type(stream) is not dict:
+            raise RuntimeError(name + " stream should be a dictionary")
+        if "format" not in stream:
+            raise RuntimeError("format not found in " + name + " stream")
+        if "size" not in stream:
+            raise RuntimeError("size not found in " + name + " stream")
+        if type(stream["format"]) is not str:
+            raise RuntimeError("format in " + name + " stream should be a string")
+        size = stream["size"]
+        if type(size) is not tuple or len(size) != 2:
+            raise RuntimeError("size in " + name + " stream should be (width, height)")
+        if size[0] % 2 or size[1] % 2:
+            raise RuntimeError("width and height should be even")
 
 
 def _to_format(rgb: np.ndarray, fmt: str) -> np.ndarray:
