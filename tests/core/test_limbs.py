@@ -177,3 +177,16 @@ def test_the_frame_edges_cut_a_side_whatever_the_search_saw() -> None:
     assert at_frame_edges(at_left, 320) == (True, False)  # the structure's own right cut is not an edge
     assert at_frame_edges(at_right, 320) == (False, True)
     assert cut_sides(at_left, 320) == (True, True)  # the edge and the structure's cut together
+
+
+def test_a_band_whose_rows_are_off_the_frame_is_skipped_quietly_and_the_other_bands_limb_stands() -> None:
+    # the frame ends in the blue band's top rows (a landmark cut by the bottom edge): the blue limb's rows
+    # (0.3 band heights about its centre) are all below the frame; numpy warned "Mean of empty slice" there
+    import warnings
+
+    img = _frame(40.3, 74.3, (50, "landmark"))[:78]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        x, sigma = measure_columns(img, _cut_both(50, 74, 0.7), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(74.3, True), abs=0.05)
+    assert sigma > 0

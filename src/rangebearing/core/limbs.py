@@ -152,6 +152,8 @@ def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGe
         y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
         x0, x1 = (rx - 4, rx + rw + reach) if right else (rx - reach, rx + rw + 4)
         tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=thin_step(y1 - y0))
+        if tile.shape[0] == 0:  # the band's rows are off the frame (a landmark cut at its top or bottom edge)
+            continue
         er, eb = excess(tile, gains)
         lin_sum = np.maximum(linear_table()[tile].sum(axis=2), 1e-3)
         ex = er if is_red else eb
