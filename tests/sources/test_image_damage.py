@@ -92,6 +92,11 @@ def test_what_the_decoder_prints_is_kept_and_another_threads_logging_passes(capf
                     b"OpenCV(5.1.0) /io/bitstrm.cpp:59: error: (-2:Unspecified error) Unexpected end\n")
     assert said == ["libpng error: IDAT: CRC error", "can't read data: Unexpected end"]
     assert capfd.readouterr().err == "2026-12-03 06:00:00,000 INFO rangebearing.x: still here\n"
+    with image_bytes._decoder_output() as said:  # another thread's traceback is no decoder's line: not swallowed
+        os.write(2, b"Traceback (most recent call last):\n  File \"x.py\", line 1\nValueError: boom\n"
+                    b"Corrupt JPEG data: 3 extraneous bytes before marker 0xd9\n")
+    assert said == ["Corrupt JPEG data: 3 extraneous bytes before marker 0xd9"]
+    assert capfd.readouterr().err == 'Traceback (most recent call last):\n  File "x.py", line 1\nValueError: boom\n'
     with image_bytes._decoder_output() as said:  # the scratch file is emptied for the next frame
         pass
     assert said == []

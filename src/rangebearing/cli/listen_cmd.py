@@ -121,8 +121,8 @@ def echo(
         Nothing valid arrived within ``timeout_s``.
     """
     tally = shown_so_far if shown_so_far is not None else _Shown()
-    shown = 0
-    while count is None or shown < count:
+    tally.count = 0
+    while count is None or tally.count < count:
         got = sub.recv_datagram(timeout_s)
         if got is None:
             where = where or f"{sub.group or sub.address[0]}:{sub.port}"
@@ -133,8 +133,7 @@ def echo(
         reading, data = got
         line = _one_line_json(data) if as_json else format_reading(reading)
         print(line, file=out, flush=True)
-        shown += 1
-        tally.count = shown
+        tally.count += 1
     return 0
 
 
@@ -159,9 +158,8 @@ def run(args: argparse.Namespace) -> int:
     if isinstance(sys.stdout, io.TextIOWrapper):  # a terminal that cannot show a character gets an escape
         sys.stdout.reconfigure(errors="backslashreplace")
     tally = _Shown()
-    previous = None
-    if threading.current_thread() is threading.main_thread():  # signal handlers live in the main thread only
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    handles_term = threading.current_thread() is threading.main_thread()  # handlers live in the main thread only
+    previous = signal.signal(signal.SIGTERM, _on_sigterm) if handles_term else None
     try:
         with sub:
             return echo(sub, sys.stdout, args.json, args.count, args.timeout, where, tally)
@@ -177,5 +175,5 @@ def run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:  # Ctrl-C is how a user ends listening: not a failure
         return 0
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        if handles_term:  # None: a handler set outside Python, which cannot be put back; the default stands in
+            signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)

@@ -152,15 +152,13 @@ def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGe
         y0, y1 = int(y_c - 0.3 * band_px), int(y_c + 0.3 * band_px) + 1
         x0, x1 = (rx - 4, rx + rw + reach) if right else (rx - reach, rx + rw + 4)
         tile, ox, _ = _tile(bgr, x0, y0, x1, y1, row_step=thin_step(y1 - y0))
-        if tile.shape[0] == 0:  # the band's rows are off the frame (a landmark cut at its top or bottom edge)
+        n = tile.shape[1]
+        if n < 4 or tile.shape[0] == 0:  # too narrow, or the band's rows off the frame (cut at its top or bottom)
             continue
         er, eb = excess(tile, gains)
         lin_sum = np.maximum(linear_table()[tile].sum(axis=2), 1e-3)
         ex = er if is_red else eb
         q = (ex / lin_sum).mean(axis=0)  # chromaticity: shading does not move it
-        n = len(q)
-        if n < 4:
-            continue
         if right:  # start inside, run right
             core = max(0, min(n - 1, int(rx + rw - ox) - int(half)))
         else:

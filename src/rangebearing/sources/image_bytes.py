@@ -80,7 +80,10 @@ def too_large(data: Union[bytes, np.ndarray]) -> bool:
 
 _capture_lock = threading.Lock()
 _capture_file: List[Tuple[int, IO[bytes]]] = []  # (pid, file): one scratch file a process, reused
-_OUR_LOG_LINE = re.compile(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d")  # another thread's logging: not the decoder's
+# What the decoders print: libpng's "libpng error/warning: ...", OpenCV's "[ERROR:0@0.02] ..." log lines,
+# libjpeg's messages (all but a few name JPEG). Anything else written meanwhile (another thread's logging or
+# traceback) is passed on.
+_DECODER_LINE = re.compile(r"^(libpng\b|\[\s*(WARN|ERROR|INFO|DEBUG)[:\]]|.*\bJPEG\b)")
 _CV_PREFIX = re.compile(r"^\[\s*[A-Z]+:\d+@[\d.]+\]\s+global\s+\S+\s+(?:\S+\s+)?\S+\(''\):\s*")
 _CV_WHERE = re.compile(r"OpenCV\([^)]*\)\s+\S+:\d+: error: \([^)]*\)\s*")
 
@@ -96,9 +99,10 @@ def _scratch() -> IO[bytes]:
 def _decoder_output() -> Iterator[List[str]]:
     """Capture what C code writes to fd 2 meanwhile; the list holds the decoder's lines afterwards.
 
-    Lines that look like Python logging (another thread writing while a frame
-    decodes) are written on to the real stderr. Without a usable fd 2 (closed)
-    nothing is captured.
+    Only the decoders' own lines (:data:`_DECODER_LINE`) are kept: anything
+    else written meanwhile (another thread's logging or traceback) goes on to
+    the real stderr, so nothing is lost. Without a usable fd 2 (closed) nothing
+    is captured.
     """
     lines: List[str] = []
     with _capture_lock:
@@ -120,15 +124,16 @@ def _decoder_output() -> Iterator[List[str]]:
             size = os.fstat(fd).st_size
             if size:
                 os.lseek(fd, 0, os.SEEK_SET)
-                text = os.read(fd, min(size, 1 << 16)).decode("utf-8", "replace")
+                with os.fdopen(os.dup(fd), "rb") as f:
+                    text = f.read(size).decode("utf-8", "replace")
                 os.ftruncate(fd, 0)
                 os.lseek(fd, 0, os.SEEK_SET)
                 passed = []
                 for line in text.splitlines():
-                    if _OUR_LOG_LINE.match(line):
-                        passed.append(line)
-                    elif line.strip():
+                    if _DECODER_LINE.match(line.strip()):
                         lines.append(_tidy(line.strip()))
+                    elif line.strip():
+                        passed.append(line)
                 if passed:
                     with contextlib.suppress(OSError):
                         os.write(saved, ("\n".join(passed) + "\n").encode())
