@@ -5,6 +5,15 @@ futures' TimeoutError past ``t``; an older one (or a stand-in written from the
 manual's first examples) takes no ``wait`` at all: the capture is then made
 without it, guarded by the daemon's capture thread (``daemon.capture``), and
 said once. A false ``wait`` returns the Job (``job.py``): its result is taken.
+
+A timed-out job can still complete: ``process_requests`` pops a job off
+``_job_list`` when it executes and signals it only afterwards, outside the
+lock, so a job that ran out of time in between is past
+``cancel_all_and_flush()`` and its request would sit in the Future, never
+released (two such leaks of the 4 buffers stall the camera until it is
+reopened). Each capture therefore passes a ``signal_function``
+(:class:`LateRequest`) that releases the request of a job given up on; a
+picamera2 that takes no ``signal_function`` is captured without it.
 A capture that hands back nothing is a skipped frame; metadata that is missing,
 not a dict, or fails to read is no metadata (the frame is stamped when it
 arrived). Whatever the library raises beyond its timeouts becomes CameraError
@@ -14,12 +23,16 @@ never a traceback out of the daemon.
 
 from __future__ import annotations
 
+import concurrent.futures
 import logging
+import threading
 from typing import Any, Callable, Dict, Optional, Tuple
 
 from ..errors import CameraError, FrameError
 
 _log = logging.getLogger(__name__)
+
+TIMEOUTS = (TimeoutError, concurrent.futures.TimeoutError)  # the builtin one is the futures' from Python 3.11
 
 
 class Notes:
@@ -35,13 +48,54 @@ class Notes:
         _log.log(level, "camera %d: " + msg, self.camera_num, *args)
 
 
+class LateRequest:
+    """A capture's ``signal_function``: releases the request of a job that completes after its capture timed out.
+
+    picamera2 calls it with the Job from its event loop once the job is done;
+    :meth:`abandon` is called when the capture gave up waiting. Whichever comes
+    second releases the request, so it is released exactly once (or never, if
+    the capture returned it).
+    """
+
+    def __init__(self, notes: Notes) -> None:
+        self._notes = notes
+        self._lock = threading.Lock()
+        self._job: Any = None
+        self._abandoned = False
+
+    def __call__(self, job: Any) -> None:
+        with self._lock:
+            self._job = job
+            abandoned = self._abandoned
+        if abandoned:
+            self._release(job)
+
+    def abandon(self) -> None:
+        with self._lock:
+            self._abandoned = True
+            job = self._job
+        if job is not None:
+            self._release(job)
+
+    def _release(self, job: Any) -> None:
+        try:
+            request = job.get_result(0)
+            if request is not None and hasattr(request, "release"):
+                request.release()
+        except Exception as exc:  # deliberately broad: runs in picamera2's event loop, which must not die
+            self._notes.once("late", "a request completed after its capture timed out: %r", exc)
+            return
+        self._notes.once("late", "a request completed after its capture timed out: released")
+
+
 class Capturer:
-    """Makes captures on one open camera; remembers whether it takes ``wait=``."""
+    """Makes captures on one open camera; remembers whether it takes ``wait=`` and ``signal_function=``."""
 
     def __init__(self, notes: Notes, timeout_s: float) -> None:
         self.notes = notes
         self.timeout_s = timeout_s
         self.takes_wait = True
+        self.takes_signal = True
 
     def call(self, capture: Callable[..., Any]) -> Any:
         """``capture(wait=timeout_s)``, or ``capture()`` for a picamera2 that takes no ``wait``."""
@@ -57,10 +111,32 @@ class Capturer:
         return capture()
 
     def request(self, capture: Callable[..., Any]) -> Any:
-        """A completed request from ``capture_request``; FrameError if the library handed back nothing."""
-        got = self.call(capture)
-        if got is not None and not hasattr(got, "release") and hasattr(got, "get_result"):
-            got = got.get_result(self.timeout_s)  # a Job: this picamera2 took the wait as false
+        """A completed request from ``capture_request``; FrameError if the library handed back nothing.
+
+        A timeout (the futures' TimeoutError) is raised on, after the job is marked given up on
+        (:class:`LateRequest`): the caller still cancels it with ``cancel_all_and_flush()``.
+        """
+        late = LateRequest(self.notes)
+
+        def signalled(**wait: Any) -> Any:
+            if self.takes_signal:
+                try:
+                    return capture(signal_function=late, **wait)
+                except TypeError as exc:  # "unexpected keyword argument 'signal_function'", "takes 1 positional"
+                    if "argument" not in str(exc):
+                        raise
+                    self.takes_signal = False
+                    self.notes.once("signal", "the capture takes no signal_function= (%s): a request completing "
+                                    "after a timeout cannot be released", exc)
+            return capture(**wait)
+
+        try:
+            got = self.call(signalled)
+            if got is not None and not hasattr(got, "release") and hasattr(got, "get_result"):
+                got = got.get_result(self.timeout_s)  # a Job: this picamera2 took the wait as false
+        except TIMEOUTS:
+            late.abandon()
+            raise
         if got is None:
             raise FrameError(f"camera {self.notes.camera_num}: the capture returned no request")
         return got

@@ -11,7 +11,10 @@ lists each behaviour relied on and what happens when a picamera2 lacks it:
   job's Future raises ``concurrent.futures.TimeoutError`` (the builtin
   TimeoutError only from Python 3.11) and the job stays queued: it would eat
   the next frame and leak its request, so ``cancel_all_and_flush()`` follows a
-  timeout. A false ``wait`` (``0``) returns the Job instead: ``timeout_s`` > 0.
+  timeout; a job already executed (popped, not yet signalled) is past that,
+  so its request is released by the capture's ``signal_function``
+  (:class:`~.camera_capture.LateRequest`). A false ``wait`` (``0``) returns
+  the Job instead: ``timeout_s`` > 0.
 * ``"RGB888"`` pixels are stored [B, G, R] (request.py maps RGB888 to PIL mode
   "BGR"), i.e. already OpenCV order. ``configure()`` may grant another format,
   size or colour space than asked (libcamera's ``validate()``): the streams are
@@ -33,7 +36,6 @@ lists each behaviour relied on and what happens when a picamera2 lacks it:
 
 from __future__ import annotations
 
-import concurrent.futures
 import logging
 import threading
 import time
@@ -46,7 +48,7 @@ from ..core.yuv import Yuv420
 from ..errors import CameraError, FrameError, SourceError
 from .base import Frame, validate_frame
 from .camera_buffers import ArrayRequest, Held, Layout, copied, granted
-from .camera_capture import Capturer, Notes, sensor_fields
+from .camera_capture import TIMEOUTS, Capturer, Notes, sensor_fields
 from .camera_setup import (
     camera_controls,
     camera_count,
@@ -62,8 +64,6 @@ __all__ = ["Picamera2Source", "camera_controls", "frames_missed", "sensor_to_mon
 from .faults import TimeoutBudget
 
 _log = logging.getLogger(__name__)
-
-_TIMEOUTS = (TimeoutError, concurrent.futures.TimeoutError)
 
 
 class Picamera2Source:
@@ -195,7 +195,7 @@ class Picamera2Source:
         self._release_held()  # the last frame is done with: its buffers go back to the camera
         try:
             request = self._capture(cam)
-        except _TIMEOUTS:
+        except TIMEOUTS:
             self._capturer.flush(cam)  # the timed-out job is still queued: it would swallow a frame
             raise self._budget.timed_out() from None
         except (FrameError, CameraError):
