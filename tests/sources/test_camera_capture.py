@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import concurrent.futures
+import threading
 from typing import Any, List, Optional
 
 import pytest
 
+from rangebearing.config import SourceConfig
+from rangebearing.errors import FrameError
+from rangebearing.sources import Picamera2Source
 from rangebearing.sources.camera_capture import Capturer, LateRequest, Notes
 
 
@@ -119,3 +123,41 @@ def test_a_job_that_failed_is_not_released() -> None:
     late.abandon()
     job._future.set_exception(concurrent.futures.CancelledError())  # cancel_all_and_flush got it: no request
     late(job)  # must not raise in picamera2's event loop
+
+
+def test_on_the_clean_room_fake_a_request_signalled_after_the_timeout_is_given_back(
+        alt_picamera2: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    _, rig = alt_picamera2
+    import picamera2.job as job_module
+
+    armed, delayed, go_on = threading.Event(), threading.Event(), threading.Event()
+    signal = job_module.Job.signal
+
+    def late_signal(job: Any) -> None:  # the event loop executed the job (off the job list), signals it late
+        if armed.is_set() and not delayed.is_set():
+            delayed.set()
+            go_on.wait(60)
+        signal(job)
+
+    monkeypatch.setattr(job_module.Job, "signal", late_signal)
+    cfg = SourceConfig(width_px=40, height_px=30, fps=30.0, timeout_s=0.3, retries=3)
+    source = Picamera2Source(cfg, sleep=lambda s: None, in_place=True)
+    source.open()
+    try:
+        assert source.read() is not None
+        armed.set()
+        with pytest.raises(FrameError, match="no frame within"):
+            source.read()
+        assert delayed.is_set()
+        go_on.set()  # the result lands in the Future after cancel_all_and_flush() could reach the job
+        for _ in range(200):
+            if rig.held() == 0:
+                break
+            rig.RIG.wait_ticks(1)
+        assert rig.held() == 0  # given back by the capture's signal_function
+        for _ in range(6):
+            assert source.read() is not None
+        assert rig.held() == 1
+    finally:
+        go_on.set()
+        source.close()
