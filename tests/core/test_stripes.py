@@ -131,3 +131,27 @@ def test_a_flag_cut_into_silhouettes_is_no_row_of_landmarks():
     # behind the other: sizes that differ by a few per cent no longer show in the rows
     far = [dataclasses.replace(c, red_xy_px=(c.red_xy_px[0], 60.0), blue_xy_px=(c.blue_xy_px[0], 78.0)) for c in row]
     assert not twins(img, far[0], far[1], GEOMETRY, cam)
+
+
+def test_far_pieces_are_twins_when_their_band_spacings_agree_and_overlapping_pieces_too():
+    from rangebearing.core.types import CameraIntrinsics
+    from rangebearing.core.verify import twins
+
+    cam = CameraIntrinsics()
+    img = encode(room(), 3.0)
+
+    def piece(x0, width, red_y, blue_y):
+        c = candidate(x0, cut=(True, True), width=width)
+        return dataclasses.replace(c, red_xy_px=(c.red_xy_px[0], red_y), blue_xy_px=(c.blue_xy_px[0], blue_y))
+
+    # 1.9 m away (18 px between the band centres), 12 px wide, side by side: spacings alike to 0.1 px put
+    # them at one depth, their axes 3.6 cm apart: one thing cut
+    a = piece(100, 12, 60.0, 78.0)
+    assert twins(img, a, piece(112, 12, 60.05, 77.95), GEOMETRY, cam)
+    # the same rows within the rows' tolerance, but spacings 0.8 px apart: ~10 cm apart in depth, two robots
+    # one behind the other may show so
+    assert not twins(img, a, piece(112, 12, 59.6, 78.4), GEOMETRY, cam)
+    # pieces that overlap (a wide run cut into silhouettes wider than half its width) are judged as well
+    b, c = piece(100, 40, 27.0, 82.0), piece(120, 40, 27.0, 82.0)
+    assert twins(img, b, c, GEOMETRY, cam) and twins(img, c, b, GEOMETRY, cam)
+    assert not twins(img, b, piece(150, 40, 27.0, 82.0), GEOMETRY, cam)  # 10 px apart: not beside it

@@ -68,11 +68,11 @@ def _stack(bottom, height, shares=(15 / 70, 40 / 70, 15 / 70)):
 PAINTS = (BLUE_PAINT, WHITE_PAINT, RED_PAINT)
 
 
-def flag(x_m, height_m):
-    """A flag on the wall 1 m away, in the landmark's stripes, 0.6 m wide, centred at the camera's height."""
-    stripes = tuple(Poster(x_m - 0.3, x_m + 0.3, lo, hi, p) for (lo, hi), p in zip(_stack(0.1 - height_m / 2,
-                                                                                        height_m), PAINTS))
-    return Scene(wall_distance_m=1.0, posters=stripes)
+def flag(x_m, height_m, wall_m=1.0, width_m=0.6, shares=(15 / 70, 40 / 70, 15 / 70)):
+    """A flag on the wall ``wall_m`` away, in the landmark's stripes (or ``shares``), centred at the camera's height."""
+    stripes = tuple(Poster(x_m - width_m / 2, x_m + width_m / 2, lo, hi, p)
+                    for (lo, hi), p in zip(_stack(0.1 - height_m / 2, height_m, shares), PAINTS))
+    return Scene(wall_distance_m=wall_m, posters=stripes)
 
 
 def can(z_m, widths):
@@ -87,6 +87,25 @@ def can(z_m, widths):
                          ids=["flag-3x", "flag-3x-left", "flag-2x-right", "can-2.2", "can-2.2-at-0.6", "can-far"])
 def test_a_wide_thing_in_the_landmarks_stripes_is_no_row_of_landmarks(scene):
     # its run is split into silhouettes of one size whose axes stand closer than two robots can
+    got = Pipeline(Config().pipeline, track=False).process(render(scene, np.random.default_rng(0))).landmarks
+    assert len(got) == 0
+
+
+@pytest.mark.parametrize("scene", [flag(0.14, 0.07, 1.4, 0.35), flag(-0.34, 0.07, 1.7, 0.35),
+                                   flag(0.2, 0.07, 2.0, 0.21)],
+                         ids=["flag-5x-at-1.4", "flag-5x-at-1.7-left", "flag-3x-at-2.0"])
+def test_a_far_flag_is_no_row_of_landmarks(scene):
+    # far away its silhouettes are a dozen pixels wide, their band rows alike to a tenth of a pixel: their
+    # sizes say one depth, though the rows' whole tolerance (1.5 px each) would allow robots a body apart
+    got = Pipeline(Config().pipeline, track=False).process(render(scene, np.random.default_rng(0))).landmarks
+    assert len(got) == 0
+
+
+@pytest.mark.parametrize("x_m", [-0.12, 0.06])
+def test_a_flag_cut_into_overlapping_silhouettes_is_no_pair_of_landmarks(x_m):
+    # a white flag with thin red and blue hems, little wider than tall: its run cut into two silhouettes that
+    # overlap by half their width, their band rows alike (one depth): two landmarks cannot stand so
+    scene = flag(x_m, 0.1, 0.6, 0.12, (0.075, 0.85, 0.075))
     got = Pipeline(Config().pipeline, track=False).process(render(scene, np.random.default_rng(0))).landmarks
     assert len(got) == 0
 

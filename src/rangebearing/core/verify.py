@@ -69,6 +69,7 @@ from .types import BBox, CameraIntrinsics, LandmarkGeometry
 
 # twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
 ROBOT_APART_M, TWIN_PX = 0.08, 1.5
+TWIN_NOISE_PX = 0.5  # band spacings measured alike differ by up to this (sub-pixel centroids)
 JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in a piece's middle (linear)
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
@@ -94,31 +95,38 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     """Whether ``o`` stands beside ``c`` at so nearly its range and so close that no robot could carry it.
 
     Landmarks ride robots: their axes stand at least a robot's width apart (``ROBOT_APART_M``).
-    Two candidates right beside each other (``2 TWIN_PX``) with the same band rows (within ``TWIN_PX``: the
-    same size and height, so nearly the same depth) whose axes would stand closer than that are one
-    thing cut in pieces: a flag, a poster or a can as wide as several landmarks, its run split into
-    silhouettes; neither is a landmark. The depths two band spacings allow differ by up to
-    ``2 TWIN_PX`` over the spacing of the depth: far away two robots one behind the other image at
-    sizes the rows cannot tell apart, and such a pair is no twin.
+    Two candidates right beside each other (``2 TWIN_PX``) or overlapping in columns, with the same band
+    rows (within ``TWIN_PX``: the same size and height, so nearly the same depth), whose axes would stand
+    closer than that are one thing cut in pieces: a flag, a poster or a can as wide as several landmarks,
+    its run split into silhouettes; neither is a landmark. How far apart in depth they stand comes from
+    their band spacings' measured difference plus ``TWIN_NOISE_PX`` (sub-pixel centroids of one size
+    differ by that much): far away two robots one behind the other image at sizes only a few tenths of
+    a pixel apart, and such a pair is no twin; a flag's pieces agree to a tenth.
     """
     if c is o:
         return False
     (x, _, w, _), (ox, _, ow, _) = c.bbox_px, o.bbox_px
-    if not (abs(ox - (x + w)) <= 2 * TWIN_PX or abs(x - (ox + ow)) <= 2 * TWIN_PX):  # right beside it, or no twin
+    if not _beside(x, w, ox, ow):  # right beside it, or no twin
         return False
     spacing = c.blue_xy_px[1] - c.red_xy_px[1]
     if spacing <= 0 or max(abs(c.red_xy_px[1] - o.red_xy_px[1]), abs(c.blue_xy_px[1] - o.blue_xy_px[1])) > TWIN_PX:
         return False
     depth_m = geometry.band_spacing_m * cam.fy_px / spacing
     apart_m = abs(c.red_xy_px[0] + c.blue_xy_px[0] - o.red_xy_px[0] - o.blue_xy_px[0]) / 2 * depth_m / cam.fx_px
-    return math.hypot(apart_m, depth_m * 2 * TWIN_PX / spacing) < ROBOT_APART_M and not limbs_between(bgr, c, o)
+    # how far apart in depth the two band spacings put them: their measured difference and its noise
+    dspacing = abs(spacing - (o.blue_xy_px[1] - o.red_xy_px[1])) + TWIN_NOISE_PX
+    return math.hypot(apart_m, depth_m * dspacing / spacing) < ROBOT_APART_M and not limbs_between(bgr, c, o)
+
+
+def _beside(x: float, w: float, ox: float, ow: float) -> bool:
+    """Whether the columns ``[ox, ox + ow)`` lie right beside ``[x, x + w)`` (``2 TWIN_PX``) or overlap them."""
+    return ox <= x + w + 2 * TWIN_PX and x <= ox + ow + 2 * TWIN_PX
 
 
 def _right_beside(c: BandCentroids, others: Sequence[BandCentroids], boxes: Sequence[BBox]) -> List[BandCentroids]:
     """The ``others`` (``boxes`` their ``bbox_px``) right beside ``c``: the only ones :func:`twins` can find twins."""
     x, _, w, _ = c.bbox_px
-    return [o for o, (ox, _, ow, _) in zip(others, boxes)
-            if o is not c and (abs(ox - (x + w)) <= 2 * TWIN_PX or abs(x - (ox + ow)) <= 2 * TWIN_PX)]
+    return [o for o, (ox, _, ow, _) in zip(others, boxes) if o is not c and _beside(x, w, ox, ow)]
 
 
 def limbs_between(bgr: np.ndarray, c: BandCentroids, o: BandCentroids) -> bool:
