@@ -211,6 +211,17 @@ def test_the_second_look_adds_only_landmarks_apart_from_those_found():
     assert second_look(found, [dataclasses.replace(walled, visible=0.75)]) == []  # narrower than its limbs
 
 
+def test_the_second_look_drops_every_piece_of_a_split_run_when_one_shows_no_limb():
+    # a fat can's run split into three silhouettes: same rows, side by side, cut where they meet
+    row = [dataclasses.replace(cand(x), cut_left=x > 40, cut_right=x < 80) for x in (40, 60, 80)]
+    assert second_look([], row) == []
+    # a landmark cut on one side where it meets the run's end (other rows: another run) stays, as does one
+    # of the same rows apart from it
+    beside, apart = dataclasses.replace(cand(100, y=42), cut_left=True), dataclasses.replace(cand(130), cut_left=True)
+    assert second_look([], [*row, beside, apart]) == [beside, apart]
+    assert second_look([], row[:1] + row[2:]) == row[:1] + row[2:]  # the ends alone: each with a limb
+
+
 def test_the_second_look_takes_the_frames_edge_for_a_cut_side():
     # photoreal-crowd 19032 frame 15: an orange wall over a white one over a dark box, cut out of the frame's
     # left edge and cut on its right: it shows no limb, as a stripe between two cuts does

@@ -155,3 +155,38 @@ def test_far_pieces_are_twins_when_their_band_spacings_agree_and_overlapping_pie
     b, c = piece(100, 40, 27.0, 82.0), piece(120, 40, 27.0, 82.0)
     assert twins(img, b, c, GEOMETRY, cam) and twins(img, c, b, GEOMETRY, cam)
     assert not twins(img, b, piece(150, 40, 27.0, 82.0), GEOMETRY, cam)  # 10 px apart: not beside it
+
+
+def test_pieces_of_a_fat_can_are_twins_when_their_centres_agree_though_their_rows_do_not():
+    from rangebearing.core.types import CameraIntrinsics
+    from rangebearing.core.verify import twins
+
+    cam = CameraIntrinsics()
+    img = encode(room(), 3.0)
+    a = candidate(60, cut=(False, True))  # 55 px between the band centres: 0.63 m away
+
+    def rows(c, red_y, blue_y):
+        return dataclasses.replace(c, red_xy_px=(c.red_xy_px[0], red_y), blue_xy_px=(c.blue_xy_px[0], blue_y))
+
+    # a can's middle piece is nearer than its end: its bands 2 px farther out each (4 px taller spacing), its
+    # centre on the same row: 4 cm nearer, its axis 4 cm over: one can, not two robots
+    middle = rows(candidate(100, cut=(True, True)), a.red_xy_px[1] - 2.0, a.blue_xy_px[1] + 2.0)
+    assert twins(img, a, middle, GEOMETRY, cam) and twins(img, middle, a, GEOMETRY, cam)
+    # the same piece 1.6 cm higher (16 px at 0.63 m): no part of one thing standing on one floor
+    assert not twins(img, a, rows(middle, middle.red_xy_px[1] - 16.0, middle.blue_xy_px[1] - 16.0), GEOMETRY, cam)
+
+
+def test_a_can_lit_from_one_side_grows_lighter_across_its_cut_two_landmarks_meet_darker():
+    from rangebearing.core.verify import limbs_between
+
+    a, b = candidate(60, cut=(False, True)), candidate(100, cut=(True, False))
+    lin = landmark(landmark(room(False), 60), 100)
+    body = lin[BODY_ROWS[0] : BODY_ROWS[1], 60:140]
+    # one can, light from its right: its body lighter column by column, the cut between its pieces' levels
+    can = lin.copy()
+    can[BODY_ROWS[0] : BODY_ROWS[1], 60:140] = body * np.linspace(0.3, 1.0, 80)[None, :, None]
+    assert not limbs_between(encode(can, 2.0), a, b)
+    # two cylinders in the same light: each darker at its limbs (cos of the normal), two limbs meet at 100
+    two = lin.copy()
+    two[BODY_ROWS[0] : BODY_ROWS[1], 60:140] = body * np.tile(np.cos(np.linspace(-1.3, 1.3, 40)), 2)[None, :, None]
+    assert limbs_between(encode(two, 2.0), a, b)

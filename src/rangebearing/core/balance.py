@@ -225,10 +225,36 @@ def second_look(found: Sequence[Candidate], more: Sequence[Candidate], frame_w_p
     blue band) run on beyond both sides of whatever the search cuts out of them: a candidate cut
     on both sides is no second-look landmark, though a real one between two neighbours may be.
     The frame's edge (``frame_w_px`` wide) shows no limb either: a stripe running out of the frame
-    is cut there (:func:`.limbs.cut_sides`).
+    is cut there (:func:`.limbs.cut_sides`). A run several silhouettes wide is split into pieces of one
+    size (:mod:`.structure`: the same rows, side by side, cut where they meet): a piece between two
+    shows no limb, and the pieces at the run's ends go with it (:func:`_pieces_of`): a wide can's
+    limbs are its ends', not a landmark's.
     """
     boxes = [_box(c) for c in found]
-    return [c for c in more if _limb_shown(c, frame_w_px) and not any(_meet(_box(c), b) for b in boxes)]
+    no_limb = [c for c in more if not _limb_shown(c, frame_w_px)]
+    dropped = _pieces_of(no_limb, more)
+    return [c for c in more if not any(c is d for d in dropped) and not any(_meet(_box(c), b) for b in boxes)]
+
+
+def _pieces_of(seeds: Sequence[Candidate], cands: Sequence[Candidate]) -> List[Candidate]:
+    """``seeds`` and every one of ``cands`` split from one run with one of them: a chain of pieces whose
+    rows and white body are the same and whose columns meet, cut where they do."""
+    out, todo = list(seeds), list(seeds)
+    while todo:
+        a = todo.pop()
+        for b in cands:
+            if not any(b is o for o in out) and _split_beside(a, b):
+                out.append(b)
+                todo.append(b)
+    return out
+
+
+def _split_beside(a: Candidate, b: Candidate) -> bool:
+    """Whether ``a`` and ``b`` are neighbouring pieces of one split run."""
+    (ax, ay, aw, ah), (bx, by, bw, bh) = a.red_bbox_px, b.red_bbox_px
+    if (ay, ah, a.blue_bbox_px[1::2], a.white_px) != (by, bh, b.blue_bbox_px[1::2], b.white_px):
+        return False
+    return (ax + aw == bx and a.cut_right and b.cut_left) or (bx + bw == ax and b.cut_right and a.cut_left)
 
 
 def _limb_shown(c: Candidate, frame_w_px: Optional[int]) -> bool:

@@ -69,8 +69,9 @@ from .types import BBox, CameraIntrinsics, LandmarkGeometry
 
 # twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
 ROBOT_APART_M, TWIN_PX = 0.08, 1.5
+TWIN_HEIGHT_M = 0.01  # ... and their centres at one height within this
 TWIN_NOISE_PX = 0.5  # band spacings measured alike differ by up to this (sub-pixel centroids)
-JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in a piece's middle (linear)
+JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in either piece's middle (linear)
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
 # height check: the tolerance is at least this, or 3 fitted sigmas ...
@@ -95,13 +96,14 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     """Whether ``o`` stands beside ``c`` at so nearly its range and so close that no robot could carry it.
 
     Landmarks ride robots: their axes stand at least a robot's width apart (``ROBOT_APART_M``).
-    Two candidates right beside each other (``2 TWIN_PX``) or overlapping in columns, with the same band
-    rows (within ``TWIN_PX``: the same size and height, so nearly the same depth), whose axes would stand
-    closer than that are one thing cut in pieces: a flag, a poster or a can as wide as several landmarks,
-    its run split into silhouettes; neither is a landmark. How far apart in depth they stand comes from
-    their band spacings' measured difference plus ``TWIN_NOISE_PX`` (sub-pixel centroids of one size
-    differ by that much): far away two robots one behind the other image at sizes only a few tenths of
-    a pixel apart, and such a pair is no twin; a flag's pieces agree to a tenth.
+    Two candidates right beside each other (``2 TWIN_PX``) or overlapping in columns, their centres at
+    one height (within ``TWIN_HEIGHT_M``), whose axes would stand closer than that are one thing cut in
+    pieces: a flag, a poster or a can as wide as several landmarks, its run split into silhouettes;
+    neither is a landmark. How far apart in depth they stand comes from their band spacings' measured
+    difference plus ``TWIN_NOISE_PX`` (sub-pixel centroids of one size differ by that much): far away
+    two robots one behind the other image at sizes only a few tenths of a pixel apart, and such a pair
+    is no twin; a flag's pieces agree to a tenth, and a fat can's middle, nearer than its ends, images
+    its bands a few pixels taller about the same centre.
     """
     if c is o:
         return False
@@ -109,9 +111,13 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     if not _beside(x, w, ox, ow):  # right beside it, or no twin
         return False
     spacing = c.blue_xy_px[1] - c.red_xy_px[1]
-    if spacing <= 0 or max(abs(c.red_xy_px[1] - o.red_xy_px[1]), abs(c.blue_xy_px[1] - o.blue_xy_px[1])) > TWIN_PX:
+    if spacing <= 0:
         return False
     depth_m = geometry.band_spacing_m * cam.fy_px / spacing
+    # at one height: the centres' rows (a wide can's middle is nearer than its ends: its bands image taller)
+    rows_off = abs(c.red_xy_px[1] + c.blue_xy_px[1] - o.red_xy_px[1] - o.blue_xy_px[1]) / 2
+    if rows_off * depth_m / cam.fy_px > TWIN_HEIGHT_M:
+        return False
     apart_m = abs(c.red_xy_px[0] + c.blue_xy_px[0] - o.red_xy_px[0] - o.blue_xy_px[0]) / 2 * depth_m / cam.fx_px
     # how far apart in depth the two band spacings put them: their measured difference and its noise
     dspacing = abs(spacing - (o.blue_xy_px[1] - o.red_xy_px[1])) + TWIN_NOISE_PX
@@ -135,8 +141,11 @@ def limbs_between(bgr: np.ndarray, c: BandCentroids, o: BandCentroids) -> bool:
     A cylinder's surface turns away from the camera at its limbs: lit by anything but light the
     same from every side, one limb at least is darker than its middle, and where two landmarks
     touch two limbs meet. A flag is as light at the cut as either side; a can's surface turns
-    smoothly through it. The darkest column within 2 px of the meeting (median over the middle
-    of the body's rows) against the lighter of the two pieces' middle fifths, in linear light.
+    smoothly through it, lit from one side lighter across the cut, the meeting between its two
+    pieces' levels. Two landmarks side by side face the camera alike in their middles, each
+    middle lighter than the limbs that meet. The darkest column within 2 px of the meeting
+    (median over the middle of the body's rows) against the darker of the two pieces' middle
+    fifths, in linear light.
     """
     a, b = sorted((c, o), key=lambda k: k.bbox_px[0])
     h, w = bgr.shape[:2]
@@ -154,7 +163,7 @@ def limbs_between(bgr: np.ndarray, c: BandCentroids, o: BandCentroids) -> bool:
     middles = [columns(k.bbox_px[0] + 0.4 * k.bbox_px[2], k.bbox_px[0] + 0.6 * k.bbox_px[2] + 1) for k in (a, b)]
     if not len(joint) or not all(len(m) for m in middles):
         return True  # nothing to judge: not one thing
-    return float(joint.min()) < JUNCTION_DIP * max(float(np.median(m)) for m in middles)
+    return float(joint.min()) < JUNCTION_DIP * min(float(np.median(m)) for m in middles)
 
 
 def height_tolerance_m(depth_m: float, model: ModelParams) -> float:
