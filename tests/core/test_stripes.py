@@ -190,3 +190,20 @@ def test_a_can_lit_from_one_side_grows_lighter_across_its_cut_two_landmarks_meet
     two = lin.copy()
     two[BODY_ROWS[0] : BODY_ROWS[1], 60:140] = body * np.tile(np.cos(np.linspace(-1.3, 1.3, 40)), 2)[None, :, None]
     assert limbs_between(encode(two, 2.0), a, b)
+
+
+def test_one_landmark_found_twice_is_no_pair_of_twins():
+    from rangebearing.core.types import CameraIntrinsics
+    from rangebearing.core.verify import twins
+
+    cam = CameraIntrinsics()
+    img = encode(landmark(room(False), 100), 3.0)
+    whole = candidate(100)
+    # a fragment of it measured apart (its white body partly hidden: another white height, other band boxes),
+    # over half its columns and its rows: one landmark twice, not two silhouettes of one wide run
+    part = candidate(112, width=24)
+    part = dataclasses.replace(part, candidate=dataclasses.replace(
+        part.candidate, white_px=34.0, red_bbox_px=(112, 24, 24, 12), blue_bbox_px=(112, 72, 24, 12)))
+    assert not twins(img, whole, part, GEOMETRY, cam) and not twins(img, part, whole, GEOMETRY, cam)
+    # the same columns split from one run (its rows and white body): twins
+    assert twins(img, whole, candidate(112, width=24), GEOMETRY, cam)

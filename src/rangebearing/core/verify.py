@@ -110,6 +110,8 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     (x, _, w, _), (ox, _, ow, _) = c.bbox_px, o.bbox_px
     if not _beside(x, w, ox, ow):  # right beside it, or no twin
         return False
+    if min(x + w, ox + ow) - max(x, ox) > 2 * TWIN_PX and not _one_run(c, o):  # overlapping: one run's pieces only
+        return False
     spacing = c.blue_xy_px[1] - c.red_xy_px[1]
     if spacing <= 0:
         return False
@@ -127,6 +129,16 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
 def _beside(x: float, w: float, ox: float, ow: float) -> bool:
     """Whether the columns ``[ox, ox + ow)`` lie right beside ``[x, x + w)`` (``2 TWIN_PX``) or overlap them."""
     return ox <= x + w + 2 * TWIN_PX and x <= ox + ow + 2 * TWIN_PX
+
+
+def _one_run(c: BandCentroids, o: BandCentroids) -> bool:
+    """Whether ``c`` and ``o`` were split from one run (:mod:`.structure`: the same band rows and white body).
+
+    Two candidates overlapping in columns are two silhouettes of one wide run, or one landmark found
+    twice (a fragment of it, its white body partly hidden, measured apart): only the first are twins."""
+    a, b = c.candidate, o.candidate
+    return (a is not None and b is not None and a.white_px == b.white_px
+            and a.red_bbox_px[1::2] == b.red_bbox_px[1::2] and a.blue_bbox_px[1::2] == b.blue_bbox_px[1::2])
 
 
 def _right_beside(c: BandCentroids, others: Sequence[BandCentroids], boxes: Sequence[BBox]) -> List[BandCentroids]:
