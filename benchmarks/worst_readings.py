@@ -2,13 +2,14 @@
 
 Usage::
 
-    python benchmarks/worst_readings.py SET_DIR --config cal.yaml [--track] [--top 25] [--by range|bearing]
+    python benchmarks/worst_readings.py SET_DIR --config cal.yaml [--track] [--top 25] [--by range|bearing] [--missed]
 
 Replays ``SET_DIR`` (a folder written by ``rangebearing synth``) through the pipeline, matches every
 reading to its truth as ``replay --truth`` does, prints the range and bearing error summary and the
 ``--top`` readings sorted by their range (or bearing) error, with the reading's sigma, visible share,
 box and the truth's visible shares. Signed errors: range positive = read too long, bearing positive
-= read too far left.
+= read too far left. ``--missed`` lists instead the findable landmarks no reading matched, with their
+truth (range, bearing, visible shares).
 """
 
 from __future__ import annotations
@@ -38,6 +39,17 @@ def signed(m: Match) -> tuple:
             db / max(f.bearing_sigma_rad, 1e-12))
 
 
+def _missed(matches: Sequence[Match]) -> int:
+    lost = [m for m in matches if m.found is None and m.truth.findable is not False]
+    print(f"{len(lost)} findable landmarks missed")
+    print("frame        range_m  bear_deg | tvis  rvis  bvis")
+    for m in lost:
+        t = m.truth
+        print(f"{m.frame:12s} {t.range_m:6.3f} {math.degrees(t.bearing_rad):+8.2f} | {t.visible or float('nan'):.2f} "
+              f"{t.red_visible or float('nan'):.2f} {t.blue_visible or float('nan'):.2f}")
+    return 0
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("folder")
@@ -45,6 +57,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     p.add_argument("--track", action="store_true")
     p.add_argument("--top", type=int, default=25)
     p.add_argument("--by", choices=("range", "bearing"), default="range")
+    p.add_argument("--missed", action="store_true", help="list the findable landmarks not found")
     args = p.parse_args(argv)
     truth = aligned_truth(args.folder, os.path.join(args.folder, "truth.csv"))
     pipe = Pipeline(load_config(args.config).pipeline, track=args.track)
@@ -53,6 +66,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     hits: List[Match] = [m for m in matches if m.found is not None]
     s = np.array([signed(m) for m in hits]) if hits else np.zeros((0, 4))
     print(f"{args.folder}: {len(hits)} readings, found {100 * rep.findable_rate:.1f} %, false {rep.false_landmarks}")
+    if args.missed:
+        return _missed(matches)
     if not hits:
         return 0
     print(f"range err mean/p95 {rep.range_err_pct_mean:.2f}/{rep.range_err_pct_p95:.2f} %, "
