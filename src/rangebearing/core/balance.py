@@ -32,7 +32,7 @@ from .color import CLIPPED, DARK, UNIT_GAINS, Gains
 from .denoise import Box
 from .limbs import at_frame_edges, cut_sides
 from .stats import median_rows
-from .structure import Candidate, Found
+from .structure import Candidate, Found, one_run
 
 NEAR_UNIT = 0.05  # gains within 5 % of one: the two searches would find the same landmarks
 TALLER = 1.15  # of one landmark found twice, a white body this much taller is the landmark's whole
@@ -251,9 +251,9 @@ def _pieces_of(seeds: Sequence[Candidate], cands: Sequence[Candidate]) -> List[C
 
 def _split_beside(a: Candidate, b: Candidate) -> bool:
     """Whether ``a`` and ``b`` are neighbouring pieces of one split run."""
-    (ax, ay, aw, ah), (bx, by, bw, bh) = a.red_bbox_px, b.red_bbox_px
-    if (ay, ah, a.blue_bbox_px[1::2], a.white_px) != (by, bh, b.blue_bbox_px[1::2], b.white_px):
+    if not one_run(a, b):
         return False
+    ax, aw, bx, bw = a.red_bbox_px[0], a.red_bbox_px[2], b.red_bbox_px[0], b.red_bbox_px[2]
     return (ax + aw == bx and a.cut_right and b.cut_left) or (bx + bw == ax and b.cut_right and a.cut_left)
 
 

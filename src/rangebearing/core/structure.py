@@ -75,6 +75,13 @@ class Candidate:
     band_ends: Tuple[bool, bool] = (False, False)
 
 
+def one_run(a: Candidate, b: Candidate) -> bool:
+    """Whether ``a`` and ``b`` share band rows and white body: pieces of one run split into silhouettes
+    (or one landmark found twice)."""
+    return (a.white_px == b.white_px and a.red_bbox_px[1::2] == b.red_bbox_px[1::2]
+            and a.blue_bbox_px[1::2] == b.blue_bbox_px[1::2])
+
+
 def _pairable(reds: np.ndarray, blues: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(len(reds), len(blues)) arrays: the pairs :func:`region_pairs` examines (band-shaped or
     merged), the columns each pair shares and whether it is the merged kind."""

@@ -65,6 +65,7 @@ from .model import normalised
 from .params import ModelParams
 from .stats import percentile
 from .stripes import SAMPLES, striped
+from .structure import one_run
 from .types import BBox, CameraIntrinsics, LandmarkGeometry
 
 # twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
@@ -137,8 +138,7 @@ def _one_run(c: BandCentroids, o: BandCentroids) -> bool:
     Two candidates overlapping in columns are two silhouettes of one wide run, or one landmark found
     twice (a fragment of it, its white body partly hidden, measured apart): only the first are twins."""
     a, b = c.candidate, o.candidate
-    return (a is not None and b is not None and a.white_px == b.white_px
-            and a.red_bbox_px[1::2] == b.red_bbox_px[1::2] and a.blue_bbox_px[1::2] == b.blue_bbox_px[1::2])
+    return a is not None and b is not None and one_run(a, b)
 
 
 def _right_beside(c: BandCentroids, others: Sequence[BandCentroids], boxes: Sequence[BBox]) -> List[BandCentroids]:
