@@ -52,6 +52,9 @@ class ScenarioFrames:
     scene_name: str = "clean"
     sequence: bool = True  # consecutive moments of a motion (a tracker may follow them)
     yuv: List[object] = dataclasses.field(default_factory=list)  # each frame's YUV420 stream (as the ISP makes it)
+    #: every landmark of each frame's scene, findable or not (a reading of a partly hidden one is no false landmark);
+    #: empty: the same as ``truth``
+    seen: List[Tuple[LandmarkPose, ...]] = dataclasses.field(default_factory=list)
 
     def __post_init__(self) -> None:
         if not self.yuv:
@@ -215,7 +218,9 @@ def preset_scenario(
     Presets that are sequences (``sample``, ``crowd-moving``) give consecutive
     moments; the others independent draws. The truth of a frame is what the
     pipeline should find: every landmark the synth marks findable (the
-    crowd-proof presets' visibility), or every landmark of the scene.
+    crowd-proof presets' visibility), or every landmark of the scene; a reading
+    of a landmark hidden too much to be findable is neither wanted nor false
+    (``seen`` lists every landmark of the scene).
     """
     from rangebearing.synth import scene_sequence
 
@@ -227,7 +232,8 @@ def preset_scenario(
     truth = [findable(s) for s in scenes]
     n = max((len(t) for t in truth), default=0)
     sequence = preset in SEQUENCES
-    return ScenarioFrames(width_px, height_px, n, cfg, frames, truth, [], 1.0, preset, sequence)
+    seen = [tuple(s.landmarks) for s in scenes]
+    return ScenarioFrames(width_px, height_px, n, cfg, frames, truth, [], 1.0, preset, sequence, seen=seen)
 
 
 def findable(scene: Scene) -> Tuple[LandmarkPose, ...]:

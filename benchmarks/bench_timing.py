@@ -27,8 +27,11 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 from bench_frames import ScenarioFrames
 
-from rangebearing import Config, FrameResult, Pipeline
+from rangebearing import Config, FrameResult, Landmark, Pipeline
 from rangebearing._compat import frozen
+from rangebearing.evaluation.match import match_frame
+from rangebearing.evaluation.truth import TruthRow
+from rangebearing.synth.scene import LandmarkPose
 
 Process = Callable[[np.ndarray], object]
 PACED_GAP_S = (0.011, 0.033)
@@ -163,19 +166,29 @@ def count(out: object) -> int:
     return 0 if out is None else len(out)  # type: ignore[arg-type]
 
 
+def judged(out: FrameResult, sc: ScenarioFrames, i: int) -> Tuple[int, int, List[Tuple[LandmarkPose, Landmark]]]:
+    """Frame ``i``'s readings against its truth: (findable landmarks, false readings, the findable ones found).
+
+    Readings are matched (:func:`rangebearing.evaluation.match.match_frame`) to every landmark of the
+    scene, so a reading of a partly hidden landmark the truth does not ask for is not false.
+    """
+    want = sc.truth[i % len(sc.truth)]
+    seen = sc.seen[i % len(sc.seen)] if sc.seen else want
+    rows = [TruthRow(str(i), lm.range_m, lm.bearing_rad, findable=any(lm is w for w in want)) for lm in seen]
+    matches, false = match_frame(str(i), out.landmarks, rows)
+    found = [(seen[j], m.found) for j, m in enumerate(matches) if m.truth.findable and m.found is not None]
+    return len(want), len(false), found
+
+
 def _errors(contender: Contender, sc: ScenarioFrames) -> str:
-    """Worst relative range error and bearing error over the frames where the count was right."""
+    """Worst relative range error and bearing error over every findable landmark found."""
     if contender.what != "landmarks" or sc.n_landmarks == 0:
         return ""
     worst_r = worst_b = -1.0
     for i, out in contender.outputs:
         if not isinstance(out, FrameResult):
             continue
-        truth = sorted(sc.truth[i % len(sc.truth)], key=lambda lm: lm.bearing_rad)
-        got = sorted(out.landmarks, key=lambda lm: lm.bearing_rad)
-        if len(got) != len(truth) or not truth:
-            continue
-        for g, t in zip(got, truth):
+        for t, g in judged(out, sc, i)[2]:
             worst_r = max(worst_r, abs(g.range_m - t.range_m) / t.range_m)
             worst_b = max(worst_b, abs(g.bearing_rad - t.bearing_rad))
     if worst_r < 0:
@@ -184,16 +197,29 @@ def _errors(contender: Contender, sc: ScenarioFrames) -> str:
 
 
 def _found(contender: Contender, sc: ScenarioFrames) -> Tuple[str, bool]:
-    """What it found per frame against what it should have, ✓ when every frame was right."""
-    got = [count(o) for _, o in contender.outputs]
+    """What it found per frame against what it should have, ✓ when every frame was right.
+
+    A landmark contender's frame is right when every findable landmark was found and no reading is
+    false (:func:`judged`); a marker detector's when it counted the markers there are.
+    """
+    if contender.what == "landmarks" and all(isinstance(o, FrameResult) for _, o in contender.outputs):
+        marks = [judged(o, sc, i) for i, o in contender.outputs]  # type: ignore[arg-type]
+        got = [len(m[2]) for m in marks]
+        false = sum(m[1] for m in marks)
+        right = [len(m[2]) == m[0] and m[1] == 0 for m in marks]
+    else:
+        got = [count(o) for _, o in contender.outputs]
+        false = 0
+        right = [g == contender.expected(i) for g, (i, _) in zip(got, contender.outputs)]
     want = [contender.expected(i) for i, _ in contender.outputs]
-    ok = got == want
-    good = sum(g == w for g, w in zip(got, want))
+    ok = all(right)
     if min(want) == max(want):
         text = f"{min(got)}–{max(got)}" if min(got) != max(got) else f"{got[0]}"
         text = f"{text} of {want[0]} {contender.what}"
     else:
-        text = f"{good}/{len(got)} frames right ({min(want)}–{max(want)} {contender.what})"
+        text = f"{sum(right)}/{len(got)} frames right ({min(want)}–{max(want)} {contender.what})"
+    if false:
+        text += f", {false} false"
     note = " (≤ 1 by design)" if contender.name == "paper" and max(want) > 1 else ""
     return f"{text} {'✓' if ok else '✗'}{note}", ok
 

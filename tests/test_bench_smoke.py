@@ -208,3 +208,27 @@ def test_painted_tag_bitmaps_are_the_apriltag_library_codes():
         grey[40:104, 20 + 120 * k: 84 + 120 * k] = img
     detect = tags.make_detector(2.0)
     assert sorted(detect(np.dstack([grey] * 3))) == [3, 17, 250]
+
+
+def test_a_reading_of_a_partly_hidden_landmark_is_neither_wanted_nor_false():
+    timing, frames_mod = bench_module("bench_timing"), bench_module("bench_frames")
+    from rangebearing import FrameResult, Landmark
+    from rangebearing.synth.scene import LandmarkPose
+
+    near, hidden, far = LandmarkPose(0.5, 0.1), LandmarkPose(0.8, 0.1), LandmarkPose(1.5, -0.3)
+
+    def reading(r: float, b: float) -> Landmark:
+        return Landmark(r, b, r, 0.0, 60.0, (0.0, 0.0), (0.0, 0.0), 10.0, (0, 0, 1, 1), True)
+
+    sc = frames_mod.ScenarioFrames(640, 480, 2, Config(), [], [(near, far)] * 3, [], 1.0, "crowd",
+                                   seen=[(near, hidden, far)] * 3)
+    outs = [FrameResult((reading(0.51, 0.1), reading(0.79, 0.1), reading(1.5, -0.3))),  # the hidden one too: right
+            FrameResult((reading(0.5, 0.1),)),  # the far one missed
+            FrameResult((reading(0.5, 0.1), reading(1.5, -0.3), reading(0.3, 0.4)))]  # one false
+    assert [(w, f, len(got)) for w, f, got in (timing.judged(o, sc, i) for i, o in enumerate(outs))] == [
+        (2, 0, 2), (2, 0, 1), (2, 1, 2)]
+    c = timing.Contender("full", lambda f: None, lambda i: 2)
+    c.outputs = list(enumerate(outs))
+    text, ok = timing._found(c, sc)
+    assert not ok and text == "1–2 of 2 landmarks, 1 false ✗"
+    assert timing._errors(c, sc) == "2.0 % / 0.00°"  # the worst findable one, matched, not zipped by bearing
