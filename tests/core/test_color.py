@@ -98,8 +98,9 @@ def test_only_pixels_with_a_channel_at_250_or_more_are_clipped():
     assert clipped_mask(frame).tolist() == [[255, 0, 255, 0]]
 
 
-@pytest.mark.parametrize("gains", [(1.0, 1.0, 1.0), (1.3, 1.0, 0.8)])
+@pytest.mark.parametrize("gains", [(1.0, 1.0, 1.0), (1.3, 1.0, 0.8), (0.7, 1.0, 1.4)])
 def test_search_image_class_masks_are_color_class_masks(gains):
+    from rangebearing.core.colour_tune import relaxed_hues
     from rangebearing.core.gain_clip import pushed_over, reclass_pushed
     from rangebearing.core.params import DetectionParams
     from rangebearing.core.search_image import SearchImage
@@ -112,10 +113,11 @@ def test_search_image_class_masks_are_color_class_masks(gains):
     hsv = to_hsv(apply_gains(small, gains))
     clip = clipped_mask(small) if min(gains) < 0.98 else None
     assert np.array_equal(img.hsv, hsv)
-    for s_min, v_min in ((cfg.s_min, cfg.v_min), (60, 30), (cfg.s_min, cfg.v_min)):  # again: the cached views
-        got = img.class_masks(cfg, s_min, v_min)
-        want = class_masks(hsv, cfg.red_hue, cfg.blue_hue, s_min, v_min, clip)
+    wide = relaxed_hues(cfg)  # the second look's hue ranges: other hue masks from the same clipped pixels
+    for c, s_min, v_min in ((cfg, cfg.s_min, cfg.v_min), (cfg, 60, 30), (wide, 60, 30), (cfg, cfg.s_min, cfg.v_min)):
+        got = img.class_masks(c, s_min, v_min)  # the last again: the cached views
+        want = class_masks(hsv, c.red_hue, c.blue_hue, s_min, v_min, clip)
         # and the pixels a gain above one pushed to 255 classed by their colour before it (core/gain_clip.py)
-        want = reclass_pushed(*want, small, gains, pushed_over(small, gains, hsv[..., 2]), cfg.red_hue, cfg.blue_hue,
+        want = reclass_pushed(*want, small, gains, pushed_over(small, gains, hsv[..., 2]), c.red_hue, c.blue_hue,
                               s_min)
         assert all(np.array_equal(g, w) for g, w in zip(got, want))

@@ -4,7 +4,7 @@ against each window scanned on its own."""
 import numpy as np
 import pytest
 
-from rangebearing.core.columns import TOP_TOL, WHITE_SHARE, bridge, column_edges, runs, window_runs
+from rangebearing.core.columns import TOP_TOL, WHITE_SHARE, _run_medians, bridge, column_edges, runs, window_runs
 
 
 def reference_column(red, blue, white):
@@ -85,6 +85,35 @@ def test_stacked_windows_give_each_window_its_own_runs():
             for s0, s1 in runs(ok, e1, e2)
         ]
         assert found == want
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_window_searched_alone_gives_the_runs_it_gets_in_a_stack(seed):
+    # a lone window takes the unpadded path (its masks transposed as they are): the same runs and medians
+    rng = np.random.default_rng(20 + seed)
+    h, w = 40, 70
+    red, blue, white = random_window(rng, h, w)
+    hsv = np.zeros((h, w, 3), np.uint8)
+    hsv[..., 1] = np.where(white, 10, 200)
+    hsv[..., 2] = 200
+    masks = red.astype(np.uint8) * 255, blue.astype(np.uint8) * 255
+    wins = [(0, 40, 0, 25), (3, 33, 20, 70), (8, 40, 10, 45)]  # one stack: each within 4x of the tallest
+    stacked = window_runs(*masks, hsv, wins)
+    assert any(stacked)
+    for win, found in zip(wins, stacked):
+        assert window_runs(*masks, hsv, [win]) == [found]
+
+
+@pytest.mark.parametrize("n_runs", [1, 3])
+def test_run_medians_are_numpys_medians(n_runs):
+    rng = np.random.default_rng(n_runs)
+    values = rng.integers(-5, 40, (5, 50)).astype(np.float64)
+    bounds = np.sort(rng.choice(np.arange(51), 2 * n_runs, replace=False))
+    s0, s1 = bounds[0::2], bounds[1::2]
+    got = _run_medians(values, s0, s1)
+    assert got.shape == (5, n_runs)
+    for q, (a, z) in enumerate(zip(s0, s1)):
+        assert got[:, q].tolist() == np.median(values[:, a:z], axis=1).tolist()
 
 
 def test_a_landmark_above_its_robot_wins_the_column_over_the_robots_whiter_red_white_blue():

@@ -7,6 +7,7 @@ Columns are independent, so every pair window of a frame is scanned in one stack
 
 from __future__ import annotations
 
+import itertools
 from typing import Callable, List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -47,19 +48,19 @@ def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     """
     w, h = red.shape
     base = np.arange(w, dtype=np.int64) * h  # flat index of each column's row 0
-    edge = red.copy()
-    edge[:, :-1] &= ~red[:, 1:]
+    # each edge is one comparison of neighbouring rows (True > False: set here, clear in the next row)
+    edge = np.empty_like(red)
+    np.greater(red[:, :-1], red[:, 1:], out=edge[:, :-1])
     edge[:, -1] = False
     red_bottoms = _nonzero(edge)
-    edge = red.copy()
-    edge[:, 1:] &= ~red[:, :-1]
+    np.greater(red[:, 1:], red[:, :-1], out=edge[:, 1:])
+    edge[:, 0] = red[:, 0]
     red_tops = _nonzero(edge)
-    edge = blue.copy()
-    edge[:, 1:] &= ~blue[:, :-1]
+    np.greater(blue[:, 1:], blue[:, :-1], out=edge[:, 1:])
     edge[:, 0] = False
     tops = _nonzero(edge)
-    edge = blue.copy()
-    edge[:, :-1] &= ~blue[:, 1:]
+    np.greater(blue[:, :-1], blue[:, 1:], out=edge[:, :-1])
+    edge[:, -1] = blue[:, -1]
     blue_bottoms = _nonzero(edge)
     col = tops // h
     # the last red bottom above each blue top, in its column (else none: -1)
@@ -95,7 +96,7 @@ def scan_columns(red: np.ndarray, blue: np.ndarray, white: np.ndarray) -> Tuple[
     # blue run starting at y2 (end: the first blue bottom at or below it); without a pair, from row 0
     start = base + y2
     run_b = np.zeros(w, np.int64)
-    in_blue = blue[np.arange(w), y2]
+    in_blue = blue.reshape(-1)[start]
     if in_blue.any():
         c = _nonzero(in_blue)
         run_b[c] = blue_bottoms[blue_bottoms.searchsorted(start[c])] - start[c] + 1
@@ -113,23 +114,26 @@ def bridge(
     """
     ok, y1, y2 = ok.copy(), y1.astype(np.float64), y2.astype(np.float64)
     n = len(ok)
-    seg = np.zeros(n, np.int64)
+    seg = None  # each column's window, when there are several (one window: none to compare)
     if len(starts):
+        seg = np.zeros(n, np.int64)
         seg[np.asarray(starts, np.int64)] = 1
         seg = seg.cumsum()
     idx = _nonzero(ok)
     d = idx[1:] - idx[:-1]
-    gaps = _nonzero((d > 1) & (d <= BRIDGE + 1) & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
+    near = (d > 1) & (d <= BRIDGE + 1)
+    gaps = _nonzero(near if seg is None else near & (seg[idx[1:]] == seg[idx[:-1]]))  # usually none
     for g in gaps.tolist():
         a, b = idx[g], idx[g + 1]
         if abs(y1[a] - y1[b]) <= 1 and abs(y2[a] - y2[b]) <= 1:
             ok[a + 1 : b] = True
             y1[a + 1 : b], y2[a + 1 : b] = y1[a], y2[a]
     if n >= 3:
-        inner = (seg[:-2] == seg[1:-1]) & (seg[2:] == seg[1:-1])  # both neighbours in the same window
+        inner = None if seg is None else (seg[:-2] == seg[1:-1]) & (seg[2:] == seg[1:-1])  # neighbours in its window
         for y in (y1, y2):
             a, b, c = y[:-2], y[1:-1], y[2:]
-            y[1:-1] = np.where(inner, np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c)), b)
+            med = np.maximum(np.minimum(a, b), np.minimum(np.maximum(a, b), c))
+            y[1:-1] = med if inner is None else np.where(inner, med, b)
     return ok, y1, y2
 
 
@@ -184,17 +188,24 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
         batch = [k for k in order if heights[k] * STACK_WASTE >= top]
         order = [k for k in order if heights[k] * STACK_WASTE < top]
         widths = [wins[k][3] - wins[k][2] for k in batch]
-        offs = np.concatenate(([0], np.cumsum(widths))).astype(np.int64)
-        r = np.zeros((int(offs[-1]), top), np.uint8)  # one row per window column (see scan_columns)
-        b = np.zeros_like(r)
-        sv = np.zeros((*r.shape, 2), np.uint8)  # padding: no colour, V = 0 is not white
-        for k, o, w in zip(batch, offs.tolist(), widths):
-            y0, y1, x0, x1 = wins[k]
-            h = y1 - y0
-            r[o : o + w, :h] = red[y0:y1, x0:x1].T
-            b[o : o + w, :h] = blue[y0:y1, x0:x1].T
-            sv[o : o + w, :h] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:].transpose(1, 0, 2)
-        white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= white_v_min)
+        offs = np.array([0, *itertools.accumulate(widths)], np.int64)
+        if len(batch) == 1:  # a window of its own: its masks transposed, nothing padded
+            y0, y1, x0, x1 = wins[batch[0]]
+            sv = hsv[slice(y0, y1), slice(x0, x1)]
+            white = np.ascontiguousarray(((sv[..., 1] < WHITE_S_MAX) & (sv[..., 2] >= white_v_min)).T)
+            r = np.ascontiguousarray(red[y0:y1, x0:x1].T)
+            b = np.ascontiguousarray(blue[y0:y1, x0:x1].T)
+        else:
+            r = np.zeros((int(offs[-1]), top), np.uint8)  # one row per window column (see scan_columns)
+            b = np.zeros_like(r)
+            sv = np.zeros((*r.shape, 2), np.uint8)  # padding: no colour, V = 0 is not white
+            for k, o, w in zip(batch, offs.tolist(), widths):
+                y0, y1, x0, x1 = wins[k]
+                h = y1 - y0
+                r[o : o + w, :h] = red[y0:y1, x0:x1].T
+                b[o : o + w, :h] = blue[y0:y1, x0:x1].T
+                sv[o : o + w, :h] = hsv[slice(y0, y1), slice(x0, x1)][..., 1:].transpose(1, 0, 2)
+            white = (sv[..., 0] < WHITE_S_MAX) & (sv[..., 1] >= white_v_min)
         ok, e1, e2, run_r, run_b = scan_columns(r > 0, b > 0, white)
         starts = offs[1:-1]
         ok, e1, e2 = bridge(ok, e1, e2, starts)
@@ -216,6 +227,11 @@ def window_runs(red: np.ndarray, blue: np.ndarray, hsv, wins: Sequence[Window],
 def _run_medians(values: np.ndarray, s0: np.ndarray, s1: np.ndarray) -> np.ndarray:
     """(K, R) medians of each of K value rows over each run's columns ``[s0, s1)`` (``np.median``'s values)."""
     n = s1 - s0
+    if len(n) == 1 and s1[0] > s0[0]:  # one run (the common case): its columns are one slice
+        a, z = int(s0[0]), int(s1[0])
+        v = np.sort(values[:, a:z].astype(np.float64), axis=1)
+        lo, hi = (z - a - 1) // 2, (z - a) // 2
+        return 0.5 * (v[:, lo : lo + 1] + v[:, hi : hi + 1])
     cols = s0[:, None] + np.arange(int(n.max()))[None, :]
     inside = cols < s1[:, None]
     v = np.where(inside[None], values[:, np.minimum(cols, values.shape[1] - 1)].astype(np.float64), np.inf)

@@ -14,7 +14,7 @@ from typing import Dict, Optional, Tuple
 import cv2
 import numpy as np
 
-from .color import Gains, apply_gains, class_hues, clip_of, clipped_mask, sv_gate, to_hsv
+from .color import Gains, apply_gains, class_hues, clip_of, clipped_mask, clipped_v, sv_gate, to_hsv
 from .gain_clip import pushed_over, reclass_pushed
 from .params import DetectionParams
 
@@ -22,7 +22,7 @@ from .params import DetectionParams
 class SearchImage:
     """The views of one downscaled BGR frame (``small``, uint8) under ``gains``, made on first use."""
 
-    __slots__ = ("_clipped", "_hsv_split", "_hues", "_pushed", "gains", "hsv", "small")
+    __slots__ = ("_clip_v", "_clipped", "_hsv_split", "_hues", "_pushed", "_vivid_clip", "gains", "hsv", "small")
 
     def __init__(self, small: np.ndarray, gains: Gains) -> None:
         self.small, self.gains = small, gains
@@ -31,6 +31,8 @@ class SearchImage:
         self._hues: Dict[tuple, Tuple[np.ndarray, np.ndarray]] = {}  # the hue masks by the ranges they are of
         self._clipped: Optional[Tuple[Optional[np.ndarray]]] = None
         self._pushed: Optional[tuple] = None  # (gain_clip.pushed_over,) once made
+        self._clip_v: Optional[np.ndarray] = None  # color.clipped_v: every gate and hue lookup reads it
+        self._vivid_clip: Optional[np.ndarray] = None  # color.clip_of: the same for every hue range
 
     def clipped(self) -> Optional[np.ndarray]:
         """Pixels clipped before the gains, when a gain below one may have hidden it (else ``None``)."""
@@ -43,11 +45,15 @@ class SearchImage:
         if self._hsv_split is None:
             self._hsv_split = tuple(cv2.split(self.hsv))
         h, s, v = self._hsv_split
+        if self._clip_v is None:
+            self._clip_v = clipped_v(v, self.clipped())
         key = (tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)))
         if key not in self._hues:
-            self._hues[key] = class_hues(h, cfg.red_hue, cfg.blue_hue, clip_of(s, v, self.clipped()))
+            if self._vivid_clip is None:
+                self._vivid_clip = clip_of(s, v, clip_v=self._clip_v)
+            self._hues[key] = class_hues(h, cfg.red_hue, cfg.blue_hue, self._vivid_clip)
         red_h, blue_h = self._hues[key]
-        sv = sv_gate(s, v, s_min, v_min, self.clipped())
+        sv = sv_gate(s, v, s_min, v_min, clip_v=self._clip_v)
         if self._pushed is None:
             self._pushed = (pushed_over(self.small, self.gains, v),)
         return reclass_pushed(cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv), self.small, self.gains,
