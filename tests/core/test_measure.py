@@ -9,6 +9,7 @@ import pytest
 from rangebearing import Pipeline, load_config
 from rangebearing.core.band_seed import seeded_band
 from rangebearing.core.limb_edge import limb
+from rangebearing.core.limbs import moments_outline
 from rangebearing.core.measure import measure_rows, outline_centre
 from rangebearing.core.structure import Candidate
 from rangebearing.core.types import LandmarkGeometry
@@ -31,6 +32,37 @@ def test_outline_centre_from_either_limb_is_the_mean_of_the_two_tangent_images(p
     centre = 0.5 * (left + right)
     assert outline_centre(right, True, cx, f, white_px, GEOMETRY) == pytest.approx(centre, abs=1e-3)
     assert outline_centre(left, False, cx, f, white_px, GEOMETRY) == pytest.approx(centre, abs=1e-3)
+
+
+def _band_moment(phi_rad, range_m, f, cx):
+    """Column of a band's area moment on the visible half of the cylinder: each image column weighted
+    by the band's height there, ``∝ 1/Z`` of the surface point it shows."""
+    r = GEOMETRY.radius_m
+    ax, az = range_m * math.sin(phi_rad), range_m * math.cos(phi_rad)
+    t = np.linspace(0.0, 2.0 * math.pi, 400001)
+    px, pz = ax + r * np.sin(t), az + r * np.cos(t)
+    seen = np.sin(t) * px + np.cos(t) * pz < 0.0  # the surface's normal faces the camera
+    x, z = px[seen] / pz[seen], pz[seen]
+    order = np.argsort(x)
+    x, z = x[order], z[order]
+    w = np.gradient(x) / z
+    return cx + f * float(np.sum(x * w) / np.sum(w))
+
+
+@pytest.mark.parametrize("phi_rad", [-0.42, 0.0, 0.25, 0.45])
+@pytest.mark.parametrize("range_m", [0.22, 0.4, 1.0])
+def test_moments_outline_takes_the_bands_moment_to_the_outline_centre(phi_rad, range_m):
+    f, cx = 634.0, 319.5
+    r = GEOMETRY.radius_m
+    alpha = math.asin(r / range_m)
+    centre = 0.5 * sum(cx + f * math.tan(phi_rad + s * alpha) for s in (-1, 1))
+    white_m = GEOMETRY.height_m - 2 * GEOMETRY.band_height_m
+    white_px = f * white_m / ((range_m - r) * math.cos(phi_rad))
+    moment = _band_moment(phi_rad, range_m, f, cx)
+    shift = moment - centre  # outward off the axis: 0.2-0.9 px this near
+    assert shift * phi_rad >= 0.0 and (phi_rad == 0.0 or range_m > 0.5 or abs(shift) > 0.1)
+    corrected = moments_outline(moment, cx, f, white_px, GEOMETRY)
+    assert abs(corrected - centre) <= 0.1 * abs(shift) + 1e-3
 
 
 def _profile(n, edge, level, bg):

@@ -30,6 +30,7 @@ from .color import Gains, apply_gains, class_masks, clipped_mask, hue_mask, rela
 from .colour_tune import relaxed_hues
 from .denoise import Box, band_masks, median_filter, none_apart_filtered
 from .gain_clip import pushed_over, reclass_pushed
+from .limbs import moments_outline
 from .measure import CENTROID_SIGMA_X_PX, cut_sides, measure_columns, measure_rows, measure_rows_all
 from .params import DetectionParams
 from .refine import BandFix, Pyramid, half_or_area, measure_bands
@@ -199,6 +200,8 @@ def combine(
         x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
         if c.hidden_band:  # a partly hidden band's moments are pulled off the axis: the whole one places both
             x_r = x_b = x_b if c.hidden_band == "red" else x_r
+        cx_px = 0.5 * (bgr.shape[1] - 1)
+        x_r, x_b = (moments_outline(x, cx_px, fy_px, rows.white_px, geometry) for x in (x_r, x_b))
     else:
         x_r = x_b = cols[0]
         sx = cols[1]
