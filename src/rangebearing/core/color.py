@@ -242,8 +242,9 @@ def class_masks(
     """The red and the blue :func:`hue_mask` of one image, sharing the channel split and S/V gate
     (``clipped``: see :func:`sv_gate`)."""
     h, s, v = cv2.split(hsv)
-    sv = sv_gate(s, v, s_min, v_min, clipped)
-    red, blue = class_hues(h, red_hue, blue_hue, clip_of(s, v, clipped))
+    clip_v = clipped_v(v, clipped)
+    sv = sv_gate(s, v, s_min, v_min, clipped, clip_v)
+    red, blue = class_hues(h, red_hue, blue_hue, clip_of(s, v, clipped, clip_v))
     return cv2.bitwise_and(red, sv), cv2.bitwise_and(blue, sv)
 
 

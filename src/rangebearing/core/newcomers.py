@@ -156,18 +156,16 @@ def beside_count(bgr: np.ndarray, cfg: DetectionParams, gains: Gains, boxes: Seq
         return 0
     rows = max(-(-(y1 - y0) // 2) for y0, y1, _, _ in strips)
     img = np.zeros((rows, sum(-(-(x1 - x0) // 2) for _, _, x0, x1 in strips), 3), np.uint8)  # black pads
-    at, followed = 0, []
+    at = 0
     for y0, y1, x0, x1 in strips:
         n = -(-(x1 - x0) // 2)
         img[: -(-(y1 - y0) // 2), at : at + n] = bgr[y0:y1:2, x0:x1:2]
-        for bx, _, bw, _ in boxes:  # a followed landmark's columns (x0 + 2k inside its box)
-            k0, k1 = max(0, -(-(bx - x0) // 2)), min(n, -(-(bx + bw - x0) // 2))
-            if k1 > k0:
-                followed.append((at + k0, at + k1))
         at += n
-    both = _both_colours(img, cfg, gains)
-    for k0, k1 in followed:
-        both[k0:k1] = False
+    followed = np.zeros(w, bool)  # the followed landmarks' columns (full resolution)
+    for bx, _, bw, _ in boxes:
+        followed[max(0, bx) : max(0, bx + bw)] = True
+    xs = np.concatenate([np.arange(x0, x1, 2) for _, _, x0, x1 in strips])  # img's columns, in the frame
+    both = _both_colours(img, cfg, gains) & ~followed[xs]
     return int(np.count_nonzero(both))
 
 
