@@ -5,7 +5,7 @@ import pytest
 
 from rangebearing.core import detect
 from rangebearing.core.color import to_hsv
-from rangebearing.core.detect import refine
+from rangebearing.core.detect import SPACING_AGREE, WHITE_SLACK_PX, refine, spacing_agrees
 from rangebearing.core.params import DetectionParams
 from rangebearing.core.refine import band_weights, measure_bands, tile_centroids
 from rangebearing.core.structure import Candidate
@@ -142,3 +142,19 @@ def test_tile_sums_are_numpys_exact_integer_sums():
     for n, h, w in ((1, 3, 4), (5, 17, 23), (2, 120, 200)):
         a = rng.integers(0, 256, (n * h, w), dtype=np.uint8)
         assert np.array_equal(_tile_sums(a, n), a.reshape(n, -1).sum(axis=1, dtype=np.int64))
+
+
+def test_a_body_measured_thin_by_colour_bleed_still_agrees_with_its_band_spacing():
+    k = GEOMETRY.band_spacing_m / 0.040  # 55 mm of spacing over a 40 mm white body
+    assert k == pytest.approx(1.375)
+    # 1.05 m under the photoreal-alt camera: spacing 35.2 px, the body 24 px: the search saw 26, the edges 20.4
+    assert 35.2 / (20.4 * k) > SPACING_AGREE[1] and spacing_agrees(35.2, 20.4, GEOMETRY, 26.0)
+    assert not spacing_agrees(35.2, 20.4, GEOMETRY)  # without the search's body: no slack
+    top = SPACING_AGREE[1] * (20.4 + WHITE_SLACK_PX) * k  # the body up to the slack taller, no more
+    assert spacing_agrees(top - 0.01, 20.4, GEOMETRY, 40.0) and not spacing_agrees(top + 0.01, 20.4, GEOMETRY, 40.0)
+    # the search and the edges alike (10 px at 1/2, 8.03 measured): a spacing of 1.26 bodies is no landmark
+    assert not spacing_agrees(13.92, 8.03, GEOMETRY, 10.0)
+    # bleed only thins a body: a spacing short of a thick one gets no slack
+    low = SPACING_AGREE[0] * 20.4 * k
+    assert spacing_agrees(low + 0.01, 20.4, GEOMETRY, 26.0) and not spacing_agrees(low - 0.01, 20.4, GEOMETRY, 26.0)
+    assert not spacing_agrees(2.0, 0.0, GEOMETRY, 10.0)  # no body, no landmark
