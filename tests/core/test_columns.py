@@ -55,6 +55,14 @@ def random_window(rng, h, w):
     return cls == 1, cls == 2, white & (cls == 0) | (cls == 3)
 
 
+def window_images(red, blue, white):
+    """The HSV image (white: low S, every pixel bright) and the 8-bit red and blue masks of a class window."""
+    hsv = np.zeros((*white.shape, 3), np.uint8)
+    hsv[..., 1] = np.where(white, 10, 200)
+    hsv[..., 2] = 200
+    return hsv, (red.astype(np.uint8) * 255, blue.astype(np.uint8) * 255)
+
+
 @pytest.mark.parametrize("seed", range(6))
 def test_column_edges_match_a_pixel_by_pixel_reference(seed):
     rng = np.random.default_rng(seed)
@@ -71,10 +79,7 @@ def test_stacked_windows_give_each_window_its_own_runs():
     rng = np.random.default_rng(7)
     h, w = 60, 90
     red, blue, white = random_window(rng, h, w)
-    hsv = np.zeros((h, w, 3), np.uint8)
-    hsv[..., 1] = np.where(white, 10, 200)
-    hsv[..., 2] = 200
-    masks = red.astype(np.uint8) * 255, blue.astype(np.uint8) * 255
+    hsv, masks = window_images(red, blue, white)
     wins = [(0, 60, 0, 30), (5, 25, 20, 50), (10, 58, 40, 90), (30, 35, 0, 4), (0, 8, 60, 61)]
     got = window_runs(*masks, hsv, wins)
     for (y0, y1, x0, x1), found in zip(wins, got):
@@ -93,10 +98,7 @@ def test_a_window_searched_alone_gives_the_runs_it_gets_in_a_stack(seed):
     rng = np.random.default_rng(20 + seed)
     h, w = 40, 70
     red, blue, white = random_window(rng, h, w)
-    hsv = np.zeros((h, w, 3), np.uint8)
-    hsv[..., 1] = np.where(white, 10, 200)
-    hsv[..., 2] = 200
-    masks = red.astype(np.uint8) * 255, blue.astype(np.uint8) * 255
+    hsv, masks = window_images(red, blue, white)
     wins = [(0, 40, 0, 25), (3, 33, 20, 70), (8, 40, 10, 45)]  # one stack: each within 4x of the tallest
     stacked = window_runs(*masks, hsv, wins)
     assert any(stacked)
