@@ -8,7 +8,7 @@ import pytest
 from rangebearing.core.detect import BandCentroids
 from rangebearing.core.stripes import colour, log_error, same
 from rangebearing.core.structure import Candidate
-from rangebearing.core.types import LandmarkGeometry
+from rangebearing.core.types import CameraIntrinsics, LandmarkGeometry
 from rangebearing.core.verify import rejection, verdicts
 
 GEOMETRY = LandmarkGeometry()
@@ -207,3 +207,26 @@ def test_one_landmark_found_twice_is_no_pair_of_twins():
     assert not twins(img, whole, part, GEOMETRY, cam) and not twins(img, part, whole, GEOMETRY, cam)
     # the same columns split from one run (its rows and white body): twins
     assert twins(img, whole, candidate(112, width=24), GEOMETRY, cam)
+
+
+def test_a_landmark_is_no_twin_of_stripes_rejected_for_their_own_reason(monkeypatch):
+    import rangebearing.core.verify as verify
+
+    # a real landmark (100-140) and, right beside it, a piece of striped wall of its size (141-153): the
+    # piece is stripes; the landmark is taken as its twin (as a band of the wall's hue can make it)
+    lin = room(False)
+    lin[:, 140:] = room()[:, 140:]
+    img = encode(landmark(lin, 100), 3.0)
+    real, piece = candidate(100, cut=(False, True)), candidate(141, cut=(True, True), width=12)
+    monkeypatch.setattr(verify, "twins", lambda bgr, c, o, geometry, cam: c is real and o is piece)
+    cam = CameraIntrinsics()
+    got = verdicts(img, [real, piece], GEOMETRY, cam=cam)
+    assert got[0] is None and "stripes" in got[1]  # the stripes have a reason of their own: no twin of it
+    # the same piece of wall cut on both sides (no limb of its own): a piece of something wider stays one
+    cut = dataclasses.replace(real, candidate=dataclasses.replace(real.candidate, cut_left=True))
+    monkeypatch.setattr(verify, "twins", lambda bgr, c, o, geometry, cam: c is cut and o is piece)
+    assert verdicts(img, [cut, piece], GEOMETRY, cam=cam)[0] == verify.TWINNED
+    # two pieces of one can, each the other's twin: both stay one thing cut
+    a, b = candidate(100, cut=(False, True)), candidate(140, cut=(True, False))
+    monkeypatch.setattr(verify, "twins", lambda bgr, c, o, geometry, cam: {c, o} <= {a, b})
+    assert verdicts(img, [a, b], GEOMETRY, cam=cam) == [verify.TWINNED] * 2

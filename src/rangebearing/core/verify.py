@@ -72,6 +72,7 @@ from .types import BBox, CameraIntrinsics, LandmarkGeometry
 ROBOT_APART_M, TWIN_PX = 0.08, 1.5
 TWIN_HEIGHT_M = 0.01  # ... and their centres at one height within this
 TWIN_NOISE_PX = 0.5  # band spacings measured alike differ by up to this (sub-pixel centroids)
+TWINNED = "a candidate of its size beside it, closer than two robots' landmarks can stand: one thing cut"
 JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in either piece's middle (linear)
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
 WHITE_PCT, BAND_PCT = 90, 75  # robust levels: the body's brightest tenth, the bands' upper quartile
@@ -197,7 +198,8 @@ def height_off_m(c: BandCentroids, model: ModelParams, cam: CameraIntrinsics) ->
 
 def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, model: Optional[ModelParams] = None,
               cam: Optional[CameraIntrinsics] = None, others: Sequence[BandCentroids] = (),
-              boxes: Optional[Sequence[BBox]] = None) -> Optional[str]:
+              boxes: Optional[Sequence[BBox]] = None,
+              twin_pool: Optional[Tuple[Sequence[BandCentroids], Sequence[BBox]]] = None) -> Optional[str]:
     """Why ``c`` is no landmark, or ``None`` when it passes every check (see the module docstring).
 
     Parameters
@@ -215,6 +217,9 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
         The frame's other candidates (touching neighbours are no stripes).
     boxes : sequence of BBox, optional
         ``o.bbox_px`` of each of ``others``, when the caller has them (:func:`verdicts`: once a frame).
+    twin_pool : (candidates, their boxes), optional
+        Whom ``c`` may be a twin of, when not ``others`` (:func:`verdicts`: the candidates not rejected
+        for a reason of their own).
     """
     cand = c.candidate
     if model is not None and cam is not None and model.centre_sigma_m > 0:
@@ -224,8 +229,9 @@ def rejection(bgr: np.ndarray, c: BandCentroids, geometry: LandmarkGeometry, mod
     elif cand is not None and cand.red_merged and cand.blue_merged:
         return "both bands merge with their backgrounds: no edge of the landmark's own"
     boxes = [o.bbox_px for o in others] if boxes is None else boxes
-    if cam is not None and any(twins(bgr, c, o, geometry, cam) for o in _right_beside(c, others, boxes)):
-        return "a candidate of its size beside it, closer than two robots' landmarks can stand: one thing cut"
+    pool, pool_boxes = (others, boxes) if twin_pool is None else twin_pool
+    if cam is not None and any(twins(bgr, c, o, geometry, cam) for o in _right_beside(c, pool, pool_boxes)):
+        return TWINNED
     ry, by = c.red_xy_px[1], c.blue_xy_px[1]
     spacing = by - ry
     if spacing <= 0:
@@ -255,21 +261,33 @@ def verdicts(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: Landmark
     A neighbour excuses its columns from the stripes test because a landmark shows its own bands
     and body there; a "neighbour" rejected is no landmark, and stripes often hold several false
     candidates side by side (a skirting board cut by masts and robots), each excusing the next.
-    The candidates passing are judged again against those still passing, once more at most.
+    The candidates passing are judged again against those still passing, once more at most. So is
+    a candidate rejected only as the twin of another (:data:`TWINNED`) that shows a limb of its own,
+    its twins now those not rejected for a reason of their own: a real landmark is not one thing with
+    the stripes beside it (a band of the wall's hue), while the pieces of one can stay each other's
+    twins, and a piece cut on both sides (no limb: a piece of something wider) stays one.
     """
     boxes = [c.bbox_px for c in found]  # a property: made once a frame, not once a pair
     why = [rejection(bgr, c, geometry, model, cam, found, boxes) for c in found]
     for _ in range(2):
         kept = [c for c, w in zip(found, why) if w is None]
-        if len(kept) in (0, len(found)):
+        if len(kept) == len(found):
             break
         kept_boxes = [b for b, w in zip(boxes, why) if w is None]
-        again = [rejection(bgr, c, geometry, model, cam, kept, kept_boxes) if w is None else w
-                 for c, w in zip(found, why)]
+        standing = [(c, b) for c, b, w in zip(found, boxes, why) if w in (None, TWINNED)]
+        pool = ([c for c, _ in standing], [b for _, b in standing])
+        again = [rejection(bgr, c, geometry, model, cam, kept, kept_boxes, pool) if w is None or (
+                 w == TWINNED and _own_limb(c)) else w for c, w in zip(found, why)]
         if again == why:
             break
         why = again
     return why
+
+
+def _own_limb(c: BandCentroids) -> bool:
+    """Whether ``c`` shows a limb of its own (its run not cut on both sides): not only a piece of something wider."""
+    cand = c.candidate
+    return cand is None or not (cand.cut_left and cand.cut_right)
 
 
 def verified(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: LandmarkGeometry,
