@@ -10,6 +10,7 @@ from rangebearing.core.color import (
     clip_of,
     clipped_hue_tables,
     clipped_mask,
+    clipped_v,
     to_hsv,
 )
 
@@ -54,7 +55,7 @@ def test_a_white_bodys_tinted_highlight_stays_out_of_the_classes(bgr):
     # a clipped white body under a warm or a cool light: as pale as the body the column scan calls white
     assert classes(bgr) == (False, False)
     hsv = to_hsv(patch(bgr))
-    assert not clip_of(hsv[..., 1], hsv[..., 2]).any()
+    assert not clip_of(hsv[..., 1], clipped_v(hsv[..., 2])).any()
 
 
 def test_the_wider_ranges_never_meet_nor_take_the_other_class():

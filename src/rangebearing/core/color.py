@@ -175,17 +175,14 @@ def class_hues(h: np.ndarray, red_hue: HueRanges, blue_hue: HueRanges, clip: Opt
 CLIPPED_HUE_S_MIN = 80  # a clipped pixel paler than this (a white body's highlight: S < 80) keeps the plain ranges
 
 
-def clip_of(s: np.ndarray, v: np.ndarray, clipped: Optional[np.ndarray] = None,
-            clip_v: Optional[np.ndarray] = None) -> np.ndarray:
-    """0/255 mask of the pixels :func:`class_hues` reads with the clipped pixels' wider hues: clipped after
-    the gains (V ≥ ``CLIPPED``) or, per ``clipped``, before them, and no paler than ``CLIPPED_HUE_S_MIN``.
+def clip_of(s: np.ndarray, clip: np.ndarray) -> np.ndarray:
+    """0/255 mask of the pixels :func:`class_hues` reads with the clipped pixels' wider hues: the clipped
+    ones (``clip``, :func:`clipped_v`) no paler than ``CLIPPED_HUE_S_MIN``.
 
     A white body's clipped highlight under a tinted light (a red wall's bounce, a warm lamp) reads
     (255, 220, 200): its hue is a red band's widened one, but it is as pale as the body the column
-    scan calls white, and it must stay white there. ``clip_v``: :func:`clipped_v` of ``v`` and ``clipped``,
-    when already made.
+    scan calls white, and it must stay white there.
     """
-    clip = clipped_v(v, clipped) if clip_v is None else clip_v
     _, vivid = cv2.threshold(s, CLIPPED_HUE_S_MIN - 1, 255, cv2.THRESH_BINARY)
     return cv2.bitwise_and(clip, vivid)
 
@@ -209,20 +206,17 @@ def clipped_mask(bgr: np.ndarray) -> np.ndarray:
     return cv2.max(cv2.max(b, g), r)
 
 
-def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int, clipped: Optional[np.ndarray] = None,
-            clip_v: Optional[np.ndarray] = None) -> np.ndarray:
-    """0/255 mask of S ≥ s_min and V ≥ v_min; where V is clipped (≥ 250), S ≥ s_min/2 suffices.
+def sv_gate(s: np.ndarray, v: np.ndarray, s_min: int, v_min: int, clip: np.ndarray) -> np.ndarray:
+    """0/255 mask of S ≥ s_min and V ≥ v_min; where clipped (``clip``, :func:`clipped_v`), S ≥ s_min/2 suffices.
 
     A clipped pixel has lost part of its chroma to saturation of the sensor
     (a band in a spotlight reads (255, 200, 190)): its hue is still right but
-    its saturation is lower than the paint's. ``clipped`` (0/255, optional)
-    marks more pixels as clipped: those clipped before the white-balance gains
-    (:func:`clipped_mask`). ``clip_v``: :func:`clipped_v` of ``v`` and ``clipped``, when already made.
+    its saturation is lower than the paint's. :func:`clipped_v` marks the pixels
+    clipped after the gains (V ≥ 250) and those clipped before them (:func:`clipped_mask`).
     """
     _, s_ok = cv2.threshold(s, s_min - 1, 255, cv2.THRESH_BINARY)
     _, v_ok = cv2.threshold(v, v_min - 1, 255, cv2.THRESH_BINARY)
     _, s_half = cv2.threshold(s, s_min // 2 - 1, 255, cv2.THRESH_BINARY)
-    clip = clipped_v(v, clipped) if clip_v is None else clip_v
     return cv2.bitwise_or(cv2.bitwise_and(s_ok, v_ok), cv2.bitwise_and(s_half, clip))
 
 
@@ -232,7 +226,7 @@ def hue_mask(hsv: np.ndarray, hue_ranges: HueRanges, s_min: int, v_min: int) -> 
     Red wraps around hue 0, so it is given as two ranges, e.g. ``[(0, 10), (165, 179)]``.
     """
     h, s, v = cv2.split(hsv)
-    return cv2.bitwise_and(hue_in(h, hue_ranges), sv_gate(s, v, s_min, v_min))
+    return cv2.bitwise_and(hue_in(h, hue_ranges), sv_gate(s, v, s_min, v_min, clipped_v(v)))
 
 
 def class_masks(
@@ -242,9 +236,9 @@ def class_masks(
     """The red and the blue :func:`hue_mask` of one image, sharing the channel split and S/V gate
     (``clipped``: see :func:`sv_gate`)."""
     h, s, v = cv2.split(hsv)
-    clip_v = clipped_v(v, clipped)
-    sv = sv_gate(s, v, s_min, v_min, clipped, clip_v)
-    red, blue = class_hues(h, red_hue, blue_hue, clip_of(s, v, clipped, clip_v))
+    clip = clipped_v(v, clipped)
+    sv = sv_gate(s, v, s_min, v_min, clip)
+    red, blue = class_hues(h, red_hue, blue_hue, clip_of(s, clip))
     return cv2.bitwise_and(red, sv), cv2.bitwise_and(blue, sv)
 
 

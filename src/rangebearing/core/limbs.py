@@ -181,6 +181,13 @@ def _limb_edge(bgr: np.ndarray, c: Candidate, gains: Gains, geometry: LandmarkGe
     return min(edges) if right else max(edges)
 
 
+def _half_angle(f_px: float, white_px: float, sec_phi: float, geometry: LandmarkGeometry) -> float:
+    """α = asin(r/d): half the angle the cylinder subtends, its axis at range d from the white height
+    (``white_px`` on the near surface at depth ``(d − r)·cos φ``; ``sec_phi`` = 1/cos φ)."""
+    z_m = f_px * (geometry.height_m - 2 * geometry.band_height_m) / max(white_px, 1e-3)
+    return math.asin(min(1.0, geometry.radius_m / (z_m * sec_phi + geometry.radius_m)))
+
+
 def outline_centre(
     limb_px: float, right: bool, cx_px: float, f_px: float, white_px: float, geometry: LandmarkGeometry
 ) -> float:
@@ -195,13 +202,10 @@ def outline_centre(
     fx = fy: an error of a few pixels in either changes the result by hundredths
     of a pixel.
     """
-    white_m = geometry.height_m - 2 * geometry.band_height_m
-    z_m = f_px * white_m / max(white_px, 1e-3)
     phi_l = math.atan((limb_px - cx_px) / f_px)
     phi = phi_l
     for _ in range(OUTLINE_ITERATIONS):
-        d = z_m / math.cos(phi) + geometry.radius_m
-        alpha = math.asin(min(1.0, geometry.radius_m / d))
+        alpha = _half_angle(f_px, white_px, 1.0 / math.cos(phi), geometry)
         phi = phi_l - alpha if right else phi_l + alpha
     other = math.tan(phi - alpha if right else phi + alpha)
     return cx_px + 0.5 * f_px * (math.tan(phi_l) + other)
@@ -218,8 +222,6 @@ def moments_outline(x_px: float, cx_px: float, f_px: float, white_px: float, geo
     ``α²·tan φ/(3·cos²φ)`` (to first order in α: at 0.15 m 5 % less): 0.5 px at 0.25 m and 23°,
     0.05 px at 0.8 m. The range d comes from the white height, as in :func:`outline_centre`.
     """
-    white_m = geometry.height_m - 2 * geometry.band_height_m
     x_n = (x_px - cx_px) / f_px
-    d = f_px * white_m / max(white_px, 1e-3) * math.hypot(1.0, x_n) + geometry.radius_m
-    alpha = math.asin(min(1.0, geometry.radius_m / d))
+    alpha = _half_angle(f_px, white_px, math.hypot(1.0, x_n), geometry)
     return x_px - f_px * alpha * alpha * x_n * (1.0 + x_n * x_n) / 3.0

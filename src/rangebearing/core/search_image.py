@@ -50,10 +50,10 @@ class SearchImage:
         key = (tuple(map(tuple, cfg.red_hue)), tuple(map(tuple, cfg.blue_hue)))
         if key not in self._hues:
             if self._vivid_clip is None:
-                self._vivid_clip = clip_of(s, v, clip_v=self._clip_v)
+                self._vivid_clip = clip_of(s, self._clip_v)
             self._hues[key] = class_hues(h, cfg.red_hue, cfg.blue_hue, self._vivid_clip)
         red_h, blue_h = self._hues[key]
-        sv = sv_gate(s, v, s_min, v_min, clip_v=self._clip_v)
+        sv = sv_gate(s, v, s_min, v_min, self._clip_v)
         if self._pushed is None:
             self._pushed = (pushed_over(self.small, self.gains, v),)
         return reclass_pushed(cv2.bitwise_and(red_h, sv), cv2.bitwise_and(blue_h, sv), self.small, self.gains,
