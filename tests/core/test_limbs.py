@@ -190,3 +190,50 @@ def test_a_band_whose_rows_are_off_the_frame_is_skipped_quietly_and_the_other_ba
         x, sigma = measure_columns(img, _cut_both(50, 74, 0.7), (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
     assert x == pytest.approx(_centre(74.3, True), abs=0.05)
     assert sigma > 0
+
+
+def _half_px():
+    half = ROWS.white_px * GEOMETRY.radius_m / (GEOMETRY.height_m - 2 * GEOMETRY.band_height_m)
+    return half * (1.0 - GEOMETRY.radius_m / (F_PX * 0.04 / ROWS.white_px + GEOMETRY.radius_m))
+
+
+@pytest.mark.parametrize("visible", [0.8, 1.0])
+@pytest.mark.parametrize("moments_off_px", [-3.0, 1.0])
+def test_a_landmark_seen_narrower_than_its_silhouette_and_cut_nowhere_is_placed_between_its_limbs(
+        visible, moments_off_px):
+    # its shaded right side (bands at a quarter of their light from column 64, their chromaticity kept) fell
+    # out of the run the search saw (to 68, the limb at 73.5): the moments of what it saw sit left (3 px); the
+    # limbs place it. Moments 1 px off agree with the outline: the finer measure, they stand
+    half, x0 = _half_px(), 40.2
+    cols = np.arange(160, dtype=np.float64)
+    cover = np.clip(np.minimum(x0 + 2 * half - (cols - 0.5), (cols + 0.5) - x0), 0.0, 1.0)[:, None]
+    shade = np.where(cols >= 64, 0.25, 1.0)[:, None]
+    lin = np.full((120, 160, 3), 0.30)
+    for (r0, r1), rgb, s in (((20, 35), (0.70, 0.07, 0.06), shade), ((35, 75), (0.85,) * 3, 1.0),
+                             ((75, 90), (0.06, 0.12, 0.65), shade)):
+        lin[r0:r1] = cover * s * np.array(rgb) + (1 - cover) * lin[r0:r1]
+    img = np.round(255.0 * lin[..., ::-1] ** (1 / 2.2)).astype(np.uint8)
+    c = Candidate((41, 20, 27, 15), (41, 76, 27, 15), 40.0, False, False, False, False, visible)
+    got = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS, moments_x_px=x0 + half + moments_off_px)
+    if visible < 1.0 and moments_off_px < -2.0:
+        assert got is not None and got[0] == pytest.approx(x0 + half, abs=0.1)
+    else:  # seen as wide as its silhouette, or the moments near the outline's centre: they stand
+        assert got is None
+
+
+def test_cut_by_the_frame_edge_and_marked_cut_on_the_other_side_it_is_placed_from_that_sides_limb():
+    # the frame ends at column 160, inside the landmark (limb at 130.3); the search marked its left side cut
+    # (a far landmark's band of its colour touching it): the left limb ends the run and places it
+    img = _frame(130.3, 130.3 + 2 * _half_px())
+    c = Candidate((131, 20, 29, 15), (131, 76, 29, 15), 40.0, False, False, True, False, 0.6)
+    x, sigma = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert x == pytest.approx(_centre(130.3, False), abs=0.05)
+    assert sigma > 0
+    # a red box left of it at the red band's rows carries that band on past the run's start: no limb ends
+    # the run there, the moments stand
+    lin = (img.astype(np.float64) / 255.0) ** 2.2
+    lin[20:35, 100:130] = (0.06, 0.07, 0.70)  # BGR: red
+    lin[75:90, 100:130] = (0.65, 0.12, 0.06)  # BGR: blue
+    img = np.round(255.0 * lin ** (1 / 2.2)).astype(np.uint8)
+    got = measure_columns(img, c, (1.0, 1.0, 1.0), GEOMETRY, F_PX, ROWS)
+    assert got is None or abs(got[0] - _centre(130.3, False)) < 0.3

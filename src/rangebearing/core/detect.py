@@ -215,7 +215,7 @@ def combine(
     # ... and the white body measured here must be the one the structure search found at 1/downscale
     if not c.white_px / WHITE_AGREE - WHITE_SLACK_PX <= rows.white_px <= c.white_px * WHITE_AGREE + WHITE_SLACK_PX:
         return None
-    cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid)
+    cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
     if cols is None:
         x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
         if c.hidden_band:  # a partly hidden band's moments are pulled off the axis: the whole one places both

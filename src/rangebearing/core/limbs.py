@@ -1,7 +1,8 @@
 """Columns of a landmark cut on one side, from its other limb.
 
 A landmark seen whole is measured by the saturation-weighted moments of
-:mod:`.refine`. One cut on a side (a nearer landmark in front, a neighbour
+:mod:`.refine`; one seen narrower than its silhouette though cut nowhere (a side too dim for the
+structure search) by its limbs. One cut on a side (a nearer landmark in front, a neighbour
 touching it, the frame's edge) is placed from its other limb instead: the
 moments of what is left would pull it towards the inside, by up to half a
 silhouette. The limb is found on each band's chromaticity profile
@@ -34,6 +35,7 @@ MAX_SAMPLES = 24  # columns (rows) averaged into a row (column) profile
 HIDDEN_BELOW = 0.95  # a candidate cut on both sides seen narrower than this share of its silhouette is partly hidden
 RUN_END_PX, RUN_END_SHARE = 3.0, 0.1  # a limb this far (px + share of outline) from its run's end: not its own
 WHOLE_WIDTH = 0.1  # two limbs this close (relative) to a whole outline apart are both natural
+NARROW_AGREE_PX = 2.0  # a narrow one's limbs overrule its moments this far off (~3.5 σ of the two apart)
 FRAME_EDGE_PX = 2  # a run starting this close to the frame's edge (½-resolution columns) may be cut by it
 
 
@@ -78,6 +80,7 @@ def measure_columns(
     fy_px: float,
     rows: Rows,
     pyramid: Optional[Pyramid] = None,
+    moments_x_px: Optional[float] = None,
 ) -> Optional[Tuple[float, float]]:
     """``(x_px, sigma_x_px)`` of a landmark cut on a side, from a limb; ``None``: keep the moments.
 
@@ -94,29 +97,48 @@ def measure_columns(
     background like a limb (the other runs on into a same-coloured band in front),
     from that one; where both do and they lie a whole outline apart, from their
     midpoint. Where both fall off closer together (something of another colour in
-    front on one side) the side is not known: the moments stand. Beside a nearer landmark
+    front on one side) the side is not known: the moments stand. Marked cut nowhere but seen
+    narrower than its silhouette (``visible`` below ``HIDDEN_BELOW``: a shaded or glossy side too
+    dim for the structure search, which the moments of the run it saw then miss too): the limbs
+    place it as for a candidate cut on both sides (the chromaticity they are found on does not
+    depend on shading), where they lie more than ``NARROW_AGREE_PX`` from the bands' moments'
+    column ``moments_x_px``; closer, the moments, the finer measure, stand. Cut by the frame's
+    edge on one side and marked cut by the search on the other (a far landmark's band of its
+    colour touching it): that side's limb, where it ends the run the search saw, places it.
+    Beside a nearer landmark
     (``occluded``) the side away from it is the limb, whatever the structure search marked
     there. A limb found farther than
     ``RUN_END_PX`` + ``RUN_END_SHARE`` of the outline from the end of the run the structure
     search saw on its side is not taken (a background of the band's colour carried the band on).
     """
     cut_left, cut_right = cut_sides(c, bgr.shape[1])
-    if not (cut_left or cut_right):
+    narrow = not (cut_left or cut_right) and c.visible < HIDDEN_BELOW
+    if not (cut_left or cut_right or narrow):
         return None
     rx, _, rw, _ = c.red_bbox_px
     ends = False  # the limb must end the run the structure search saw on its side
     far_at_edge = rx + rw >= bgr.shape[1] - FRAME_EDGE_PX if c.occluded == "left" else rx <= FRAME_EDGE_PX
+    frame_l, frame_r = at_frame_edges(c, bgr.shape[1])
     if c.occluded and not far_at_edge:
         # a nearer landmark hides one side: the other is the limb, where it ends the run (marked cut there, the
         # run's band met a same-coloured background; a band of the colour that carried it on would not end it)
         ends = c.cut_right if c.occluded == "left" else c.cut_left
         cut_left, cut_right = c.occluded == "left", c.occluded == "right"
-    if cut_left and cut_right and not (c.cut_left and c.cut_right and c.visible < HIDDEN_BELOW):
+    elif not c.occluded and ((frame_l and c.cut_right and not frame_r) or (frame_r and c.cut_left and not frame_l)):
+        # the frame's edge cuts one side and the structure search marked the other (a neighbour's band of its
+        # colour touching it): that side's limb, where it ends the run the search saw, places it
+        ends = True
+        cut_left, cut_right = frame_l, frame_r
+    if narrow:
+        cut_left = cut_right = True
+    if cut_left and cut_right and not ((narrow or (c.cut_left and c.cut_right)) and c.visible < HIDDEN_BELOW):
         return None  # whole, or the frame's edge cuts a side: no limb there, none known on the other
     white_m = geometry.height_m - 2 * geometry.band_height_m
     cx_px = 0.5 * (bgr.shape[1] - 1)
     d = fy_px * white_m / max(rows.white_px, 1e-3) + geometry.radius_m
     half = rows.white_px * geometry.radius_m / white_m * (1.0 - geometry.radius_m / d)
+    if narrow and (1.0 - c.visible) * half <= NARROW_AGREE_PX:
+        return None  # the run's moments lie within half its missing width of the outline's centre: they stand
     both = cut_left and cut_right
     edge_r = _limb_edge(bgr, c, gains, geometry, rows, half, True) if both or not cut_right else None
     edge_l = _limb_edge(bgr, c, gains, geometry, rows, half, False) if both or not cut_left else None
@@ -135,6 +157,8 @@ def measure_columns(
         return None
     if not rx - half <= x <= rx + rw + half:  # no limb where the structure said: keep the moments
         return None
+    if narrow and (moments_x_px is None or abs(x - moments_x_px) <= NARROW_AGREE_PX):
+        return None  # the moments agree with the outline: they are the finer measure
     return x, LIMB_SIGMA_X_PX
 
 
