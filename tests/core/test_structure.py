@@ -119,6 +119,26 @@ def test_a_wide_red_white_blue_stripe_is_no_landmark():
     assert search(img) == []
 
 
+def stack(img, x0, y0, red, white, blue, width):
+    """Paint red over white over blue stripes of the given heights."""
+    img[y0 : y0 + red, x0 : x0 + width] = RED
+    img[y0 + red : y0 + red + white, x0 : x0 + width] = WHITE
+    img[y0 + red + white : y0 + red + white + blue, x0 : x0 + width] = BLUE
+
+
+def test_a_stack_whose_bands_are_both_far_thinner_than_its_body_gives_is_no_landmark():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    stack(img, 50, 20, 3, 32, 3, 28)  # 32 px white wants 12 px bands and 28 columns: a flag's thin stripes
+    assert search(img) == []
+
+
+def test_one_band_thinned_by_something_in_front_of_it_keeps_the_landmark():
+    img = np.full((120, 160, 3), GREY, np.uint8)
+    stack(img, 50, 20, 12, 32, 3, 28)  # the blue band hidden but for 3 rows (a nearer thing below it)
+    (c,) = search(img)
+    assert c.white_px == 32 and not (c.red_merged or c.blue_merged)
+
+
 def test_the_search_is_bounded_by_max_landmarks_and_the_region_cap():
     img = np.full((480, 640, 3), GREY, np.uint8)
     for i in range(8):

@@ -1,23 +1,21 @@
 """Landmark candidates from the landmark's vertical structure, not from two isolated blobs.
 
-Down every image column a landmark reads red → white → blue: a red run, a
-white run, a blue run, with the white run's height ``h`` fixing the rest of
-the shape (bands ``h·15/40`` tall, the cylinder ``h·35/40`` wide). The inner
-red/white and white/blue edges stay sharp and local when a band's *outer* edge
-merges with a background of its colour (a red box above it, a blue mat below),
-and a red box behind the band or a neighbour's band beside it makes no such
-column. So:
+Down every image column a landmark reads red → white → blue: a red run, a white run, a blue run, with the
+white run's height ``h`` fixing the rest of the shape (bands ``h·15/40`` tall, the cylinder ``h·35/40`` wide).
+The inner red/white and white/blue edges stay sharp and local when a band's *outer* edge merges with a
+background of its colour (a red box above it, a blue mat below), and a red box behind the band or a
+neighbour's band beside it makes no such column. So:
 
-1. pair red and blue regions that could hold one landmark (overlapping
-   columns, blue starting below red), at most ``MAX_REGIONS`` of each colour;
-2. in each pair's window, find per column the red-bottom edge ``y1`` and the
-   blue-top edge ``y2`` with (mostly) white between them;
-3. cut the columns into runs whose edges are continuous: a landmark in front
-   of another has other edges, so each keeps its own columns;
-4. check each run against the cylinder's silhouette (``n`` columns ≈ ``h·35/40``):
-   a run ``k`` silhouettes wide with band-shaped runs is ``k`` landmarks side by
-   side at one range, split evenly; a narrower run is a partly hidden landmark
-   (``visible`` < 1), a much wider one is no landmark.
+1. pair red and blue regions that could hold one landmark (overlapping columns, blue starting below red),
+   at most ``MAX_REGIONS`` of each colour;
+2. in each pair's window, find per column the red-bottom edge ``y1``, blue-top ``y2``, white between;
+3. cut the columns into runs whose edges are continuous: a landmark in front of another has other edges,
+   so each keeps its own columns;
+4. check each run against the cylinder's silhouette (``n`` columns ≈ ``h·35/40``): a run ``k``
+   silhouettes wide with band-shaped runs is ``k`` landmarks side by side at one range, split evenly; a
+   narrower run is a partly hidden landmark (``visible`` < 1), a much wider one is no landmark;
+5. and its bands against its body (each 15/40 of it; what hides part of one leaves the other whole):
+   both far thinner (``THIN_BANDS``, neither merged) are another thing's stripes (a flag, a cup on a box).
 
 All coordinates here are in the downscaled masks' pixels until
 :func:`search` converts them to full-resolution pixels.
@@ -44,6 +42,8 @@ MERGED = 1.7  # a band run longer than this many expected band heights is merged
 SPLIT_TOL = 0.3  # how far from a whole number of silhouettes a wide run may be and still be split
 EXTEND_BELOW = 1.0  # narrower runs than this share of a silhouette are extended along their bands when they run on
 MIN_VISIBLE = 0.5  # narrower runs than this share of a silhouette are not reported (findable: 60 %)
+# both bands' runs under this share of the 15/40 band height (less half a mask row; real: 0.33 at least)
+THIN_BANDS, THIN_SLACK = 0.35, 0.5
 
 
 @frozen
@@ -240,6 +240,8 @@ def _candidates(reds: np.ndarray, blues: np.ndarray, red: np.ndarray, blue: np.n
         hb, w_exp = band_k * gap, width_k * gap
         red_merged = med_r > MERGED * hb + 1
         blue_merged = med_b > MERGED * hb + 1
+        if not (red_merged or blue_merged) and max(med_r, med_b) + THIN_SLACK < THIN_BANDS * hb:
+            continue  # bands far thinner than its body: stripes of another thing (step 5)
         seen, hidden, ext_l, ext_r = 1.0, "", False, False
         if (c1f - c0f) / w_exp < EXTEND_BELOW and not (red_merged or blue_merged):  # a body hidden, bands whole
             # its bands end where a nearer landmark found already hides them (core/behind.py)
