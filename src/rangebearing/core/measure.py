@@ -21,6 +21,7 @@ from typing import List, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
+from .band_fit import TALL_WHITE, _fits, _height, _hidden, _misfit, _overtall, _white_clear
 from .band_seed import body_side
 from .band_seed import seeded_band as _band
 from .color import Gains
@@ -32,9 +33,7 @@ from .types import LandmarkGeometry
 
 MISFIT_SLACK = 0.05  # the luma may spoil the proportion by this much (band heights' own scatter)
 BLED_PX = 0.25  # a luma inner edge this far from the chroma one shows the camera bleeds chroma
-SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
-WHITE_MATCH = 0.1  # ... judged only when the white height agrees this well with the structure search's
-BAND_FIT = 0.15  # a band whose edges span 15/40 of the white height within this share fits (Rows.band_y)
+WHITE_MATCH = 0.1  # a short blue band is judged only when the white height agrees this well with the search's
 
 
 @frozen
@@ -212,6 +211,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
             luma = (l_red.inner != red.inner, l_blue.inner != blue.inner)
             red, blue, white = l_red, l_blue, l_white
+    vouched = abs(white - cw) <= TALL_WHITE * cw and _white_clear(lp, red, blue)  # the white height is the body's
+    red, blue = _overtall(red, blue, 2 * k * white, vouched)
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
     factor = 1.0 + (2 * k if red.merged or blue.merged else 0.0)
@@ -231,12 +232,6 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         _fits(red, True, 2 * k * white),
         _fits(blue, False, 2 * k * white),
     )
-
-
-def _fits(band: BandEdges, red: bool, expected_px: float) -> bool:
-    """Whether a band's edges span ``expected_px`` (15/40 of the white height) within ``BAND_FIT``; a merged
-    band, placed from that height, always does."""
-    return band.merged or abs(_height(band, red) - expected_px) <= BAND_FIT * expected_px
 
 
 def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
@@ -267,33 +262,6 @@ def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
             band = BandEdges(0.5 * (inner + outer), inner, False, band.sigma, band.scatter)
         bands.append(band)
     return bands[0], bands[1], bands[1].inner - bands[0].inner
-
-
-def _misfit(red: BandEdges, blue: BandEdges, white: float, share: float) -> float:
-    """How far the measured bands' heights are from ``share`` (15/40) of the white height, relative."""
-    heights = [h for h in (_height(red, True), _height(blue, False)) if h > 0]
-    return abs(sum(heights) / max(len(heights), 1) / max(share * white, 1e-6) - 1.0)
-
-
-def _height(band: BandEdges, red: bool) -> float:
-    """A band's height between its two edges (rows); 0 when merged (its outer edge is not its own)."""
-    if band.merged:
-        return 0.0
-    return 2.0 * (band.inner - band.centre) if red else 2.0 * (band.centre - band.inner)
-
-
-def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
-    """The blue band, marked merged when it is seen shorter than ``SHORT_BAND`` of ``expected_px``.
-
-    A nearer robot's body in front hides the lower part of a landmark behind it: the blue band's
-    outer edge is then the occluder's, and the mean of its edges sits too high (L short, range long,
-    by up to ~10 %). Both bands are 15 mm on one cylinder at one depth, so the red band's height (or,
-    when it merged, 15/40 of the white body's) is what the blue one should measure. A red band cannot
-    be hidden so: whatever hides its top hides the white body below it.
-    """
-    if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
-        return blue
-    return BandEdges(blue.centre, blue.inner, True, blue.sigma, blue.scatter)
 
 
 __all__ = ["CENTROID_SIGMA_X_PX", "Rows", "cut_sides", "measure_columns", "measure_rows", "measure_rows_all",
