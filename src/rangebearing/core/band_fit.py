@@ -2,7 +2,7 @@
 
 A band seen short (a nearer robot hiding the blue band's lower part) or alone seen far too tall (a
 same-hued thing past its outer edge) is placed from its inner edge and the white height instead
-(:func:`_hidden`, :func:`_overtall`), marked merged; one whose edges span 15/40 of the white height
+(:func:`hidden_blue`, :func:`overtall`), marked merged; one whose edges span 15/40 of the white height
 within ``BAND_FIT`` fits (:class:`.measure.Rows`). Pure functions of :class:`.edges.BandEdges`.
 """
 
@@ -17,35 +17,35 @@ from .edges import BandEdges
 
 SHORT_BAND = 0.8  # a blue band seen shorter than this share of the red one (both 15 mm) is partly hidden
 BAND_FIT = 0.15  # a band whose edges span 15/40 of the white height within this share fits (Rows.band_y)
-TALL_BAND = 1.6  # a band this many times 15/40 of the white height tall has an outer edge not its own (_overtall)
+TALL_BAND = 1.6  # a band this many times 15/40 of the white height tall has an outer edge not its own (overtall)
 TALL_WHITE = 0.25  # ... judged where the white height is the structure search's within this share
-CLEAR_LUMA = 0.7  # ... and the white body's luma is this even from band to band (_white_clear)
+CLEAR_LUMA = 0.7  # ... and the white body's luma is this even from band to band (white_clear)
 CLEAR_EDGE_PX = 1.5  # ... over its rows this far inside the bands' inner edges
 
 
-def _fits(band: BandEdges, red: bool, expected_px: float) -> bool:
+def band_fits(band: BandEdges, red: bool, expected_px: float) -> bool:
     """Whether a band's edges span ``expected_px`` (15/40 of the white height) within ``BAND_FIT``; a merged
     band, placed from that height, always does."""
-    return band.merged or abs(_height(band, red) - expected_px) <= BAND_FIT * expected_px
+    return band.merged or abs(band_height(band, red) - expected_px) <= BAND_FIT * expected_px
 
 
-def _misfit(red: BandEdges, blue: BandEdges, white: float, share: float) -> float:
+def misfit(red: BandEdges, blue: BandEdges, white: float, share: float) -> float:
     """How far the measured bands' heights are from ``share`` (15/40) of the white height, relative."""
-    heights = [h for h in (_height(red, True), _height(blue, False)) if h > 0]
+    heights = [h for h in (band_height(red, True), band_height(blue, False)) if h > 0]
     return abs(sum(heights) / max(len(heights), 1) / max(share * white, 1e-6) - 1.0)
 
 
-def _height(band: BandEdges, red: bool) -> float:
+def band_height(band: BandEdges, red: bool) -> float:
     """A band's height between its two edges (rows); 0 when merged (its outer edge is not its own)."""
     if band.merged:
         return 0.0
     return 2.0 * (band.inner - band.centre) if red else 2.0 * (band.centre - band.inner)
 
 
-def _overtall(red: BandEdges, blue: BandEdges, expected_px: float, white_ok: bool) -> Tuple[BandEdges, BandEdges]:
+def overtall(red: BandEdges, blue: BandEdges, expected_px: float, white_ok: bool) -> Tuple[BandEdges, BandEdges]:
     """The bands, one marked merged where it alone is seen ``TALL_BAND`` times ``expected_px`` (15/40 of
     the white height) tall or more while the white height is vouched for (``white_ok``: it agrees with
-    the structure search's within ``TALL_WHITE`` and the body's luma is even, :func:`_white_clear`) and
+    the structure search's within ``TALL_WHITE`` and the body's luma is even, :func:`white_clear`) and
     the other band's edges span 15/40 of it (or that band is merged).
 
     A same-hued thing just beyond a band's outer edge too faint or too short for the edges to call it
@@ -55,18 +55,18 @@ def _overtall(red: BandEdges, blue: BandEdges, expected_px: float, white_ok: boo
     the band is placed from it and the white height. Both bands too tall is chroma bleed thinning the
     white body (the luma's business), so both are kept.
     """
-    tall = [not b.merged and _height(b, r) > TALL_BAND * expected_px for b, r in ((red, True), (blue, False))]
+    tall = [not b.merged and band_height(b, r) > TALL_BAND * expected_px for b, r in ((red, True), (blue, False))]
     if tall[0] == tall[1] or not white_ok:
         return red, blue
     other, r_other = (blue, False) if tall[0] else (red, True)
-    if not (other.merged or _fits(other, r_other, expected_px)):
+    if not (other.merged or band_fits(other, r_other, expected_px)):
         return red, blue
     band = red if tall[0] else blue
     placed = BandEdges(band.centre, band.inner, True, band.sigma, band.scatter)
     return (placed, blue) if tall[0] else (red, placed)
 
 
-def _white_clear(lp: Optional[np.ndarray], red: BandEdges, blue: BandEdges) -> bool:
+def white_clear(lp: Optional[np.ndarray], red: BandEdges, blue: BandEdges) -> bool:
     """Whether the white body's luma ``lp`` (the tile's row profile) is even between the bands' inner edges:
     its darkest row inside (``CLEAR_EDGE_PX`` off each edge, the edges' blur) at least ``CLEAR_LUMA`` of its
     brightest. A cylinder's white is lit alike from band to band; a darker stretch is something in front
@@ -78,7 +78,7 @@ def _white_clear(lp: Optional[np.ndarray], red: BandEdges, blue: BandEdges) -> b
     return inside.size >= 3 and float(inside.min()) >= CLEAR_LUMA * float(inside.max())
 
 
-def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
+def hidden_blue(blue: BandEdges, expected_px: float) -> BandEdges:
     """The blue band, marked merged when it is seen shorter than ``SHORT_BAND`` of ``expected_px``.
 
     A nearer robot's body in front hides the lower part of a landmark behind it: the blue band's
@@ -87,6 +87,6 @@ def _hidden(blue: BandEdges, expected_px: float) -> BandEdges:
     when it merged, 15/40 of the white body's) is what the blue one should measure. A red band cannot
     be hidden so: whatever hides its top hides the white body below it.
     """
-    if blue.merged or _height(blue, False) >= SHORT_BAND * expected_px:
+    if blue.merged or band_height(blue, False) >= SHORT_BAND * expected_px:
         return blue
     return BandEdges(blue.centre, blue.inner, True, blue.sigma, blue.scatter)

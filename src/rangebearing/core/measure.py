@@ -21,7 +21,7 @@ from typing import List, Optional, Sequence, Tuple
 import numpy as np
 
 from .._compat import frozen
-from .band_fit import TALL_WHITE, _fits, _height, _hidden, _misfit, _overtall, _white_clear
+from .band_fit import TALL_WHITE, band_fits, band_height, hidden_blue, misfit, overtall, white_clear
 from .band_seed import body_side
 from .band_seed import seeded_band as _band
 from .color import Gains
@@ -201,18 +201,19 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         return None
     white, k = blue.inner - red.inner, 0.5 * geometry.band_height_m / white_m
     cw, tol = c.white_px / f, WHITE_MATCH * c.white_px / f  # inner edges (chroma or luma) this close: the body's
-    blue = _hidden(blue, _height(red, True) or 2 * k * white) if abs(white - cw) <= tol else blue
+    blue = hidden_blue(blue, band_height(red, True) or 2 * k * white) if abs(white - cw) <= tol else blue
     luma = (False, False)
     if lp is not None and not (red.merged and blue.merged):
         l_red, l_blue, l_white = _luma_edges(lp, red, blue, 2 * k * white)
-        l_blue = _hidden(l_blue, _height(l_red, True) or 2 * k * l_white) if abs(l_white - cw) <= tol else l_blue
+        if abs(l_white - cw) <= tol:
+            l_blue = hidden_blue(l_blue, band_height(l_red, True) or 2 * k * l_white)
         # the landmark's proportions decide: chroma bleed makes the bands too tall for the white body
         # (the luma restores 15/40), while a luma edge taken from a shadow or a part in front spoils them
-        if _misfit(l_red, l_blue, l_white, 2 * k) <= _misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
+        if misfit(l_red, l_blue, l_white, 2 * k) <= misfit(red, blue, white, 2 * k) + MISFIT_SLACK:
             luma = (l_red.inner != red.inner, l_blue.inner != blue.inner)
             red, blue, white = l_red, l_blue, l_white
-    vouched = abs(white - cw) <= TALL_WHITE * cw and _white_clear(lp, red, blue)  # the white height is the body's
-    red, blue = _overtall(red, blue, 2 * k * white, vouched)
+    vouched = abs(white - cw) <= TALL_WHITE * cw and white_clear(lp, red, blue)  # the white height is the body's
+    red, blue = overtall(red, blue, 2 * k * white, vouched)
     red_y = red.inner - k * white if red.merged else red.centre
     blue_y = blue.inner + k * white if blue.merged else blue.centre
     factor = 1.0 + (2 * k if red.merged or blue.merged else 0.0)
@@ -229,8 +230,8 @@ def _rows(c: Candidate, geometry: LandmarkGeometry, oy: int, er: np.ndarray, eb:
         math.nan if blue.merged else 2.0 * (blue.centre - blue.inner) * f,
         luma[0],
         luma[1],
-        _fits(red, True, 2 * k * white),
-        _fits(blue, False, 2 * k * white),
+        band_fits(red, True, 2 * k * white),
+        band_fits(blue, False, 2 * k * white),
     )
 
 
@@ -249,8 +250,8 @@ def _luma_edges(p: np.ndarray, red: BandEdges, blue: BandEdges, band_px: float
     bands = []
     for band, down in ((red, True), (blue, False)):
         inner = luma_edge(p, band.inner, down, band_px, True)
-        if inner is None and _height(band, down) > band_px:  # bled 3-4 px (video coding): the band as it bled
-            inner = luma_edge(p, band.inner, down, _height(band, down), True)
+        if inner is None and band_height(band, down) > band_px:  # bled 3-4 px (video coding): the band as it bled
+            inner = luma_edge(p, band.inner, down, band_height(band, down), True)
         bled = inner is not None and abs(inner - band.inner) >= BLED_PX
         inner = band.inner if inner is None else inner
         if band.merged:
