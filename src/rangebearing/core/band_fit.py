@@ -23,6 +23,11 @@ CLEAR_LUMA = 0.7  # ... and the white body's luma is this even from band to band
 CLEAR_EDGE_PX = 1.5  # ... over its rows this far inside the bands' inner edges
 
 
+def as_merged(band: BandEdges) -> BandEdges:
+    """``band`` marked merged: placed from its inner edge and the white height (its outer edge not its own)."""
+    return BandEdges(band.centre, band.inner, True, band.sigma, band.scatter)
+
+
 def band_fits(band: BandEdges, red: bool, expected_px: float) -> bool:
     """Whether a band's edges span ``expected_px`` (15/40 of the white height) within ``BAND_FIT``; a merged
     band, placed from that height, always does."""
@@ -61,9 +66,7 @@ def overtall(red: BandEdges, blue: BandEdges, expected_px: float, white_ok: bool
     other, r_other = (blue, False) if tall[0] else (red, True)
     if not (other.merged or band_fits(other, r_other, expected_px)):
         return red, blue
-    band = red if tall[0] else blue
-    placed = BandEdges(band.centre, band.inner, True, band.sigma, band.scatter)
-    return (placed, blue) if tall[0] else (red, placed)
+    return (as_merged(red), blue) if tall[0] else (red, as_merged(blue))
 
 
 def white_clear(lp: Optional[np.ndarray], red: BandEdges, blue: BandEdges) -> bool:
@@ -89,4 +92,4 @@ def hidden_blue(blue: BandEdges, expected_px: float) -> BandEdges:
     """
     if blue.merged or band_height(blue, False) >= SHORT_BAND * expected_px:
         return blue
-    return BandEdges(blue.centre, blue.inner, True, blue.sigma, blue.scatter)
+    return as_merged(blue)

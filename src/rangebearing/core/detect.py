@@ -204,8 +204,9 @@ def combine(
     """
     if red is None or blue is None:
         return None
+    moments_x_px = 0.5 * (red.xy_px[0] + blue.xy_px[0])
     if rows is _MEASURE:
-        rows = measure_rows(bgr, c, gains, geometry, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
+        rows = measure_rows(bgr, c, gains, geometry, moments_x_px)
     if rows is None:
         return None
     # the band spacing and the white body's height are two measures of one size: they must agree
@@ -215,7 +216,7 @@ def combine(
     # ... and the white body measured here must be the one the structure search found at 1/downscale
     if not c.white_px / WHITE_AGREE - WHITE_SLACK_PX <= rows.white_px <= c.white_px * WHITE_AGREE + WHITE_SLACK_PX:
         return None
-    cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid, 0.5 * (red.xy_px[0] + blue.xy_px[0]))
+    cols = measure_columns(bgr, c, gains, geometry, fy_px, rows, pyramid, moments_x_px)
     if cols is None:
         x_r, x_b, sx = red.xy_px[0], blue.xy_px[0], CENTROID_SIGMA_X_PX
         if c.hidden_band:  # a partly hidden band's moments are pulled off the axis: the whole one places both

@@ -111,14 +111,14 @@ def measure_columns(
     ``RUN_END_PX`` + ``RUN_END_SHARE`` of the outline from the end of the run the structure
     search saw on its side is not taken (a background of the band's colour carried the band on).
     """
-    cut_left, cut_right = cut_sides(c, bgr.shape[1])
+    frame_l, frame_r = at_frame_edges(c, bgr.shape[1])
+    cut_left, cut_right = c.cut_left or frame_l, c.cut_right or frame_r  # cut_sides, the frame's edges kept
     narrow = not (cut_left or cut_right) and c.visible < HIDDEN_BELOW
     if not (cut_left or cut_right or narrow):
         return None
     rx, _, rw, _ = c.red_bbox_px
     ends = False  # the limb must end the run the structure search saw on its side
     far_at_edge = rx + rw >= bgr.shape[1] - FRAME_EDGE_PX if c.occluded == "left" else rx <= FRAME_EDGE_PX
-    frame_l, frame_r = at_frame_edges(c, bgr.shape[1])
     if c.occluded and not far_at_edge:
         # a nearer landmark hides one side: the other is the limb, where it ends the run (marked cut there, the
         # run's band met a same-coloured background; a band of the colour that carried it on would not end it)
