@@ -59,6 +59,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from .crowding import ROBOT_APART_M, apart_m, crowded_out
 from .detect import BandCentroids
 from .edges import linear_table
 from .model import normalised
@@ -68,10 +69,9 @@ from .stripes import SAMPLES, striped
 from .structure import one_run
 from .types import BBox, CameraIntrinsics, LandmarkGeometry
 
-# twins: landmarks' axes stand at least a robot's width apart (a Zumo is 0.098 m by 0.086 m)
-ROBOT_APART_M, TWIN_PX = 0.08, 1.5
+# twins: landmarks' axes stand at least a robot's width apart (crowding.ROBOT_APART_M); right beside (px)
+TWIN_PX = 1.5
 TWIN_HEIGHT_M = 0.01  # ... and their centres at one height within this
-TWIN_NOISE_PX = 0.5  # band spacings measured alike differ by up to this (sub-pixel centroids)
 TWINNED = "a candidate of its size beside it, closer than two robots' landmarks can stand: one thing cut"
 JUNCTION_DIP = 0.8  # two limbs meeting: the body this much darker there than in either piece's middle (linear)
 BAND_OVER_WHITE = 1.5  # a band's own channel may reach this share of the white body's (nominal 0.8)
@@ -99,10 +99,10 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
 
     Landmarks ride robots: their axes stand at least a robot's width apart (``ROBOT_APART_M``).
     Two candidates right beside each other (``2 TWIN_PX``) or overlapping in columns, their centres at
-    one height (within ``TWIN_HEIGHT_M``), whose axes would stand closer than that are one thing cut in
-    pieces: a flag, a poster or a can as wide as several landmarks, its run split into silhouettes;
+    one height (within ``TWIN_HEIGHT_M``), whose axes would stand closer than that (:func:`.crowding.apart_m`)
+    are one thing cut in pieces: a flag, a poster or a can as wide as several landmarks, its run split into silhouettes;
     neither is a landmark. How far apart in depth they stand comes from their band spacings' measured
-    difference plus ``TWIN_NOISE_PX`` (sub-pixel centroids of one size differ by that much): far away
+    difference plus ``crowding.SPACING_NOISE_PX`` (sub-pixel centroids of one size differ by that much): far away
     two robots one behind the other image at sizes only a few tenths of a pixel apart, and such a pair
     is no twin; a flag's pieces agree to a tenth, and a fat can's middle, nearer than its ends, images
     its bands a few pixels taller about the same centre.
@@ -122,10 +122,7 @@ def twins(bgr: np.ndarray, c: BandCentroids, o: BandCentroids, geometry: Landmar
     rows_off = abs(c.red_xy_px[1] + c.blue_xy_px[1] - o.red_xy_px[1] - o.blue_xy_px[1]) / 2
     if rows_off * depth_m / cam.fy_px > TWIN_HEIGHT_M:
         return False
-    apart_m = abs(c.red_xy_px[0] + c.blue_xy_px[0] - o.red_xy_px[0] - o.blue_xy_px[0]) / 2 * depth_m / cam.fx_px
-    # how far apart in depth the two band spacings put them: their measured difference and its noise
-    dspacing = abs(spacing - (o.blue_xy_px[1] - o.red_xy_px[1])) + TWIN_NOISE_PX
-    return math.hypot(apart_m, depth_m * dspacing / spacing) < ROBOT_APART_M and not limbs_between(bgr, c, o)
+    return apart_m(c, o, geometry, cam) < ROBOT_APART_M and not limbs_between(bgr, c, o)
 
 
 def _beside(x: float, w: float, ox: float, ow: float) -> bool:
@@ -281,6 +278,9 @@ def verdicts(bgr: np.ndarray, found: Sequence[BandCentroids], geometry: Landmark
         if again == why:
             break
         why = again
+    if model is not None and cam is not None and model.centre_sigma_m > 0 and why.count(None) > 1:
+        offs = [height_off_m(c, model, cam)[0] if w is None else 0.0 for c, w in zip(found, why)]
+        why = crowded_out(found, offs, why, geometry, cam)
     return why
 
 
